@@ -1,0 +1,1 @@
+"""Timeline -> mouth motion (visemes, node trajectories). Pure: no clocks, sockets or asyncio."""

@@ -1,0 +1,1 @@
+"""The only I/O layer: FastAPI app, WebSocket protocol, channels, clocks."""

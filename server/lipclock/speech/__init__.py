@@ -1,0 +1,1 @@
+"""Text -> Timeline -> audio. Pure: no clocks, sockets or asyncio in this package."""

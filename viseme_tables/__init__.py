@@ -1,0 +1,1 @@
+"""Data package: viseme map, mouth-node topology and shapes, bigram curves."""
