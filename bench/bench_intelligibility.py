@@ -14,7 +14,8 @@ Two tests, every system through the same code in the same run, all audio at
   pooled over all sentences. Goal <= 0.35.
 
 Peers: eSpeak-NG (default voice and en-us+klatt2) and Flite (kal, and slt
-when installed), run as whole processes.
+when installed), run as whole processes. ``system:gmw/en-us`` is lipclock's
+pyttsx3 backend (eSpeak-NG's library, speech/system_voice.py), when present.
 
     .venv/bin/python bench/bench_intelligibility.py            # 300 items, 40 sentences
     .venv/bin/python bench/bench_intelligibility.py --quick    # 60 items, 10 sentences
@@ -115,11 +116,26 @@ def _lipclock(voice: str) -> Callable[[str, Path], np.ndarray]:
     return say
 
 
+def _system_voice(voice_id: str) -> Callable[[str, Path], np.ndarray]:
+    def say(text: str, tmp: Path) -> np.ndarray:
+        from lipclock.speech.system_voice import synthesize_system
+
+        return synthesize_system(text, voice_id, LISTEN_RATE).samples
+    return say
+
+
 def available_systems() -> dict[str, Callable[[str, Path], np.ndarray]]:
     systems: dict[str, Callable[[str, Path], np.ndarray]] = {
         "lipclock:adult-low": _lipclock("adult-low"),
         "lipclock:adult-high": _lipclock("adult-high"),
     }
+    try:  # lipclock's pyttsx3 backend (eSpeak-NG's library on Linux), if installed
+        from lipclock.speech.system_voice import system_voices
+
+        if "gmw/en-us" in system_voices():
+            systems["system:gmw/en-us"] = _system_voice("gmw/en-us")
+    except Exception:  # no pyttsx3 / engine: the backend is simply not listed
+        pass
     if shutil.which("espeak-ng"):
         systems["espeak"] = _espeak(None)
         systems["espeak-klatt2"] = _espeak("en-us+klatt2")
