@@ -100,3 +100,16 @@ def test_scoring_helpers() -> None:
     assert bi.rhyme_choice("would you", alts) is None
     grammar = bi.rhyme_grammar(alts)
     assert "public <s> = would you write ( bat | cat | fat | hat | mat | pat ) now ;" in grammar
+
+
+def test_listener_input_pads_and_dithers_deterministically() -> None:
+    import numpy as np
+
+    speech = np.full(1000, 500, dtype=np.int16)
+    a = bi.listener_input(speech, "would you write cat now.")
+    b = bi.listener_input(speech, "would you write cat now.")
+    c = bi.listener_input(speech, "would you write hat now.")
+    pad = bi.LISTEN_RATE // 5
+    assert len(a) == 1000 + 2 * pad and np.array_equal(a, b) and not np.array_equal(a, c)
+    assert np.count_nonzero(a[:pad]) > pad // 2  # no digital silence left
+    assert np.abs(a[pad:-pad].astype(int) - 500).max() <= 6  # dither is a few LSB only
