@@ -1,0 +1,97 @@
+"""Visemes: phones -> viseme events on the sample clock (``viseme_tables/``).
+
+The map keeps the DECface appendix distinctions that are visible: bilabial
+closure, labiodental, dental, rounded/protruded, open, spread, r-coloured.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+from ..errors import TableError
+from ..speech.phoneset import phones
+from ..speech.timeline import Timeline
+from ..tables import finite_float, iter_tsv, package_file
+
+MEASURES = ("lip_gap_mm", "width_mm", "protrusion_mm", "jaw_mm")
+
+
+@dataclass(frozen=True, slots=True)
+class VisemeShape:
+    name: str
+    lip_gap_mm: float
+    width_mm: float
+    protrusion_mm: float
+    jaw_mm: float
+
+    def vector(self) -> tuple[float, float, float, float]:
+        return (self.lip_gap_mm, self.width_mm, self.protrusion_mm, self.jaw_mm)
+
+
+@dataclass(frozen=True, slots=True)
+class VisemeEvent:
+    viseme: str
+    start: int
+    end: int
+    phone: str
+
+
+def load_shapes(path: Path) -> dict[str, VisemeShape]:
+    out: dict[str, VisemeShape] = {}
+    for line, f in iter_tsv(path):
+        if len(f) != 5:
+            raise TableError(path, line, f"expected 5 columns, got {len(f)}")
+        nums = [finite_float(path, line, m, v) for m, v in zip(MEASURES, f[1:], strict=True)]
+        if nums[0] < 0 or nums[1] <= 0 or nums[3] < 0:
+            raise TableError(path, line, "lip_gap and jaw must be >= 0, width > 0")
+        if f[0] in out:
+            raise TableError(path, line, f"duplicate viseme {f[0]!r}")
+        out[f[0]] = VisemeShape(f[0], *nums)
+    return out
+
+
+def load_phone_map(path: Path, shapes: dict[str, VisemeShape]) -> dict[str, str]:
+    known = phones()
+    out: dict[str, str] = {}
+    for line, f in iter_tsv(path):
+        if len(f) != 2:
+            raise TableError(path, line, f"expected 2 columns, got {len(f)}")
+        ph, vis = f
+        if ph not in known:
+            raise TableError(path, line, f"unknown phone {ph!r}")
+        if vis not in shapes:
+            raise TableError(path, line, f"unknown viseme {vis!r}")
+        out[ph] = vis
+    missing = sorted(set(known) - set(out))
+    if missing:
+        raise TableError(path, 1, f"phones without a viseme: {' '.join(missing)}")
+    return out
+
+
+@cache
+def shapes() -> dict[str, VisemeShape]:
+    return load_shapes(package_file("lipclock.viseme_tables", "visemes.tsv"))
+
+
+@cache
+def phone_map() -> dict[str, str]:
+    return load_phone_map(package_file("lipclock.viseme_tables", "phone_visemes.tsv"), shapes())
+
+
+def viseme_of(phone: str) -> str:
+    return phone_map()[phone.rstrip("012")]
+
+
+def visemes_for(timeline: Timeline) -> tuple[VisemeEvent, ...]:
+    """One event per phone, adjacent identical visemes merged."""
+    out: list[VisemeEvent] = []
+    for p in timeline.phones:
+        v = viseme_of(p.phone)
+        if out and out[-1].viseme == v:
+            last = out[-1]
+            out[-1] = VisemeEvent(v, last.start, p.end, last.phone)
+        else:
+            out.append(VisemeEvent(v, p.start, p.end, p.phone))
+    return tuple(out)
