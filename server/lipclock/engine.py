@@ -1,0 +1,196 @@
+"""The synthesis pipeline as an ordered list of named stages (DESIGN.md principle 2).
+
+Like flite's ``synth_method_text[]``, every stage takes the work-in-progress
+and returns it with one more field filled in. Read the order here:
+
+    normalize -> pronounce -> prosody -> visemes -> mouth -> tracks
+
+and then audio, rendered from the Klatt frames in chunks on demand
+(:meth:`Prepared.audio_chunks`), so a server can start playing after the first
+chunk. Everything here is pure: no clocks, sockets or asyncio.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from .config import Settings
+from .errors import OutOfRangeError
+from .face.models import mouth_for
+from .face.visemes import visemes_for
+from .speech import klatt, tracks
+from .speech.lexicon import Lexicon, default_lexicon, pronounce
+from .speech.normalize import normalize
+from .speech.prosody import PITCH_HZ_RANGE, ProsodySettings, build_timeline
+from .speech.timeline import Timeline
+from .speech.tokens import Pronounced, Token
+from .speech.voices import Voice, get_voice
+
+SUPPORTED_SAMPLE_RATES = (8000, 16000, 22050, 24000, 48000)
+FIRST_CHUNK_S = 0.05  # small first chunk: playback can start after ~1 ms of work
+MAX_CHUNK_S = 0.4  # later chunks end at phrase boundaries or after this much audio
+
+
+@dataclass(frozen=True)
+class Request:
+    text: str
+    voice: Voice
+    prosody: ProsodySettings
+    mouth_model: str
+    mouth_rate_hz: float
+    max_chars: int
+    lexicon: Lexicon
+
+
+@dataclass(frozen=True)
+class Work:
+    request: Request
+    tokens: tuple[Token, ...] = ()
+    pronounced: tuple[Pronounced, ...] = ()
+    timeline: Timeline | None = None
+    visemes: tuple[Any, ...] = ()
+    mouth: Any = None
+    frames: np.ndarray | None = None
+
+
+def _normalize(w: Work) -> Work:
+    r = w.request
+    return replace(w, tokens=tuple(normalize(r.text, max_chars=r.max_chars,
+                                             is_word=r.lexicon.is_word)))
+
+
+def _pronounce(w: Work) -> Work:
+    return replace(w, pronounced=tuple(pronounce(list(w.tokens), w.request.lexicon)))
+
+
+def _prosody(w: Work) -> Work:
+    return replace(w, timeline=build_timeline(w.pronounced, w.request.prosody))
+
+
+def _visemes(w: Work) -> Work:
+    assert w.timeline is not None
+    return replace(w, visemes=tuple(visemes_for(w.timeline)))
+
+
+def _mouth(w: Work) -> Work:
+    assert w.timeline is not None
+    r = w.request
+    return replace(w, mouth=mouth_for(w.timeline, model=r.mouth_model, rate_hz=r.mouth_rate_hz))
+
+
+def _tracks(w: Work) -> Work:
+    assert w.timeline is not None
+    return replace(w, frames=tracks.klatt_frames(w.timeline, w.request.voice))
+
+
+Stage = tuple[str, Callable[[Work], Work]]
+STAGES: tuple[Stage, ...] = (
+    ("normalize", _normalize),
+    ("pronounce", _pronounce),
+    ("prosody", _prosody),
+    ("visemes", _visemes),
+    ("mouth", _mouth),
+    ("tracks", _tracks),
+)
+
+
+def run_stages(work: Work, stages: tuple[Stage, ...] = STAGES) -> Work:
+    for _name, stage in stages:
+        work = stage(work)
+    return work
+
+
+def make_request(text: str, *, voice: str | None = None, rate_wpm: float | None = None,
+                 pitch_hz: float | None = None, mouth_model: str | None = None,
+                 settings: Settings | None = None, lexicon: Lexicon | None = None) -> Request:
+    """Resolve the caller's options against Settings and the voice; validate ranges."""
+    s = settings or Settings()
+    if s.sample_rate not in SUPPORTED_SAMPLE_RATES:
+        raise OutOfRangeError("sample_rate", s.sample_rate, min(SUPPORTED_SAMPLE_RATES),
+                              max(SUPPORTED_SAMPLE_RATES))
+    v = get_voice(voice or s.voice)
+    wpm = (rate_wpm if rate_wpm is not None else s.rate_wpm)
+    lo, hi = PITCH_HZ_RANGE
+    if pitch_hz is not None and not (lo <= pitch_hz <= hi):
+        raise OutOfRangeError("pitch_hz", pitch_hz, lo, hi)
+    prosody = ProsodySettings(
+        sample_rate=s.sample_rate,
+        rate_wpm=_voice_rate(_checked_rate(wpm), v),
+        base_f0_hz=pitch_hz if pitch_hz is not None else v.base_f0_hz,
+        f0_range_st=v.f0_range_st,
+        comma_pause_s=s.comma_pause_s,
+        period_pause_s=s.period_pause_s,
+    )
+    return Request(text, v, prosody, mouth_model or s.mouth_model, s.mouth_rate_hz,
+                   s.max_text_chars, lexicon or _lexicon_for(s))
+
+
+def _checked_rate(wpm: float) -> float:
+    from .speech.prosody import RATE_WPM_RANGE
+
+    lo, hi = RATE_WPM_RANGE
+    if not (lo <= wpm <= hi):
+        raise OutOfRangeError("rate_wpm", wpm, lo, hi)
+    return float(wpm)
+
+
+def _voice_rate(wpm: float, voice: Voice) -> float:
+    """The voice's ``speed`` scales the requested rate, kept inside the allowed range."""
+    from .speech.prosody import RATE_WPM_RANGE
+
+    lo, hi = RATE_WPM_RANGE
+    return min(hi, max(lo, wpm * voice.speed))
+
+
+_LEXICONS: dict[str, Lexicon] = {}
+
+
+def _lexicon_for(s: Settings) -> Lexicon:
+    if not s.user_lexicon:
+        return default_lexicon()
+    lex = _LEXICONS.get(s.user_lexicon)
+    if lex is None:
+        lex = _LEXICONS[s.user_lexicon] = Lexicon.load(s.user_lexicon)
+    return lex
+
+
+def chunk_bounds(timeline: Timeline, first_chunk_s: float = FIRST_CHUNK_S,
+                 max_chunk_s: float = MAX_CHUNK_S) -> list[int]:
+    """End samples of the audio chunks: a small first chunk, then phrase ends, capped in size."""
+    sr = timeline.sample_rate
+    total = timeline.num_samples
+    breaks = sorted({p.end for p in timeline.phrases} | {total})
+    first = min(total, max(1, round(first_chunk_s * sr)))
+    bounds = [first]
+    cap = max(1, round(max_chunk_s * sr))
+    for b in breaks:
+        while b - bounds[-1] > cap:
+            bounds.append(bounds[-1] + cap)
+        if b > bounds[-1]:
+            bounds.append(b)
+    return bounds
+
+
+def render_chunks(work: Work) -> Iterator[tuple[int, np.ndarray]]:
+    """Yield ``(start_sample, int16 samples)`` covering the utterance exactly once, in order."""
+    assert work.timeline is not None and work.frames is not None
+    r = work.request
+    renderer = klatt.KlattRenderer(work.frames, r.prosody.sample_rate, r.voice, seed=0)
+    start = 0
+    for end in chunk_bounds(work.timeline):
+        samples = renderer.render_until(end)
+        yield start, samples
+        start = end
+
+
+def prepare_work(text: str, **options: Any) -> Work:
+    return run_stages(Work(make_request(text, **options)))
+
+
+def default_lexicon_warm() -> None:
+    """Load the lexicon and compile the synthesizer (call once at server start)."""
+    default_lexicon()
