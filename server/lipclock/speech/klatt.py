@@ -153,7 +153,7 @@ def _render(frames: np.ndarray, sr: int, start: int, end: int, state: np.ndarray
         nlp = nz1 + 0.75 * state[_S_NLP1]
         state[_S_NLP1] = nlp
         mod = 1.0 if (voiced_amp == 0.0 or phase < te) else 0.5
-        asp = (ah + breath * voiced_amp * 0.12) * nlp * mod * 0.1
+        asp = (ah + breath * voiced_amp * 0.12) * nlp * mod * 0.012  # cascade gain is high: -18 dB
         fric = af * nlp * mod * 0.1
         # --- cascade
         x = tl + asp

@@ -88,6 +88,11 @@ _TRANS_S = {"vowel": 0.05, "diphthong": 0.05, "liquid": 0.04, "glide": 0.04, "na
             "silence": 0.0}
 _DEFAULTS = {kp.F4: 3300.0, kp.F5: 3750.0, kp.F6: 4900.0, kp.B4: 250.0, kp.B5: 200.0,
              kp.B6: 1000.0, kp.FNP: 270.0, kp.BNP: 100.0, kp.FNZ: 270.0, kp.BNZ: 100.0}
+# Release burst length by place: labial bursts are brief, velar ones long and
+# often double (Fant 1973; Stevens 1998, ch. 7).
+_BURST_S = {"P": 0.006, "B": 0.005, "T": 0.012, "D": 0.010, "K": 0.020, "G": 0.016}
+# /s z/ noise peaks above the default F6 (4.9 kHz): move the F6 pole up for them.
+_HIGH_F6_HZ = {"S": 6000.0, "Z": 6000.0}
 _SONORANT = {"vowel", "diphthong", "liquid", "glide", "nasal"}
 
 
@@ -236,11 +241,13 @@ def _sources(out: np.ndarray, lo: int, hi: int, t: np.ndarray, dur: float, phone
         out[lo:hi, kp.AH] = v["AH"]
     elif c == "fricative":
         out[lo:hi, kp.AV] = v["AV"]
+        if phone in _HIGH_F6_HZ:
+            out[lo:hi, kp.F6] = _HIGH_F6_HZ[phone]
         for name, col in _PAR:
             out[lo:hi, col] = v[name]
     elif c in ("stop", "affricate"):
         voiced = info(phone).voiced
-        burst_s = 0.008 if c == "stop" else 0.5 * dur
+        burst_s = _BURST_S.get(phone, 0.01) if c == "stop" else 0.5 * dur
         in_burst = t >= dur - min(burst_s, 0.5 * dur)
         if voiced and i > 0 and cls[i - 1] != "silence":
             out[lo:hi, kp.AV] = np.where(in_burst, v["AV"], 38.0)  # voice bar in closure
