@@ -8,10 +8,13 @@ The fallback order is written once, in :meth:`Lexicon.lookup` (as flite's
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
 from ..errors import TableError
+from ..tables import iter_tsv, package_file
+from .lts import lts_predict
 from .phoneset import is_valid
 from .tokens import BreakToken, Pronounced, PronouncedWord, Token, WordToken
 
@@ -136,26 +139,44 @@ class Lexicon:
         return best
 
 
-_NAIVE = {
-    "a": "AE1", "b": "B", "c": "K", "d": "D", "e": "EH1", "f": "F", "g": "G", "h": "HH",
-    "i": "IH1", "j": "JH", "k": "K", "l": "L", "m": "M", "n": "N", "o": "AA1", "p": "P",
-    "q": "K", "r": "R", "s": "S", "t": "T", "u": "AH1", "v": "V", "w": "W", "x": "K S",
-    "y": "Y", "z": "Z",
-}
+@dataclass(frozen=True, slots=True)
+class HomographRule:
+    word: str
+    phones: tuple[str, ...]
+    side: str  # "prev", "next" or "any"
+    context: frozenset[str]
 
 
-def lts_predict(word: str) -> tuple[str, ...]:
-    """Naive letter-to-sound fallback: one phone per letter, first vowel stressed."""
-    out: list[str] = []
-    stressed = False
-    for ch in word:
-        for ph in _NAIVE.get(ch, "").split():
-            if ph[-1].isdigit():
-                ph = ph[:-1] + ("0" if stressed else "1")
-                stressed = True
-            if not out or out[-1] != ph:
-                out.append(ph)
-    return tuple(out) or ("AH0",)
+def load_homographs(path: Path) -> dict[str, list[HomographRule]]:
+    rules: dict[str, list[HomographRule]] = {}
+    for line, f in iter_tsv(path):
+        if len(f) != 4:
+            raise TableError(path, line, f"expected 4 columns, got {len(f)}")
+        word, phones, side, ctx = f
+        if side not in ("prev", "next", "any"):
+            raise TableError(path, line, f"side must be prev, next or any, got {side!r}")
+        for ph in phones.split():
+            if not is_valid(ph):
+                raise TableError(path, line, f"unknown phone {ph!r}")
+        rules.setdefault(word, []).append(
+            HomographRule(word, tuple(phones.split()), side, frozenset(ctx.split())))
+    return rules
+
+
+@cache
+def homographs() -> dict[str, list[HomographRule]]:
+    return load_homographs(package_file("lipclock.speech", "data/homographs.tsv"))
+
+
+def resolve_homograph(word: str, prev: str | None, nxt: str | None) -> tuple[str, ...] | None:
+    """Context-chosen pronunciation for a homograph, or None to use the lexicon's."""
+    for rule in homographs().get(word, ()):
+        if rule.side == "any":
+            return rule.phones
+        neighbour = prev if rule.side == "prev" else nxt
+        if neighbour is not None and neighbour in rule.context:
+            return rule.phones
+    return None
 
 
 @cache
@@ -164,15 +185,31 @@ def default_lexicon() -> Lexicon:
 
 
 def pronounce(tokens: list[Token], lexicon: Lexicon | None = None) -> list[Pronounced]:
+    """Tokens -> pronounced words; breaks pass through; homographs use their neighbours."""
     lex = lexicon or default_lexicon()
     out: list[Pronounced] = []
-    for t in tokens:
+    rules = homographs()
+    for i, t in enumerate(tokens):
         if isinstance(t, BreakToken):
             out.append(t)
         elif isinstance(t, WordToken):
             if t.is_letter:
                 out.append(PronouncedWord(t.text, lex.letter(t.text), t.orth, "letter"))
-            else:
-                phones, source = lex.lookup(t.text, t.hint)
-                out.append(PronouncedWord(t.text, phones, t.orth, source))
+                continue
+            if t.text in rules and t.text not in lex.user:
+                prev = _neighbour(tokens, i, -1)
+                nxt = _neighbour(tokens, i, +1)
+                chosen = resolve_homograph(t.text, prev, nxt)
+                if chosen:
+                    out.append(PronouncedWord(t.text, chosen, t.orth, "homograph"))
+                    continue
+            phones, source = lex.lookup(t.text, t.hint)
+            out.append(PronouncedWord(t.text, phones, t.orth, source))
     return out
+
+
+def _neighbour(tokens: list[Token], i: int, step: int) -> str | None:
+    j = i + step
+    if 0 <= j < len(tokens) and isinstance(tokens[j], WordToken):
+        return tokens[j].text  # type: ignore[union-attr]
+    return None
