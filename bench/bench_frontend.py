@@ -89,7 +89,8 @@ def calibrate() -> None:
     total_s = tl.duration_s
     n = len(tl.words)
     print(f"words={n} speech={speech_s:.1f}s total={total_s:.1f}s")
-    print(f"articulation rate at scale 1.0: {60 * n / speech_s:.1f} wpm (NATURAL_WPM={NATURAL_WPM})")
+    rate = 60 * n / speech_s
+    print(f"articulation rate at scale 1.0: {rate:.1f} wpm (NATURAL_WPM={NATURAL_WPM})")
     print(f"overall rate incl. pauses:       {60 * n / total_s:.1f} wpm")
 
 

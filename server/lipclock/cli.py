@@ -128,7 +128,7 @@ def _add_timeline(sub: argparse._SubParsersAction) -> None:  # type: ignore[type
 
 
 def _timeline(args: argparse.Namespace, settings: Settings) -> int:
-    from .engine import _normalize, _pronounce, _prosody, Work, make_request, run_stages
+    from .engine import Work, _normalize, _pronounce, _prosody, make_request, run_stages
 
     req = make_request(args.text, voice=args.voice, rate_wpm=args.rate, settings=settings)
     work = run_stages(Work(req), (("normalize", _normalize), ("pronounce", _pronounce),

@@ -42,12 +42,13 @@ BREAKS = {",": BreakKind.COMMA, ".": BreakKind.PERIOD, "?": BreakKind.QUESTION,
 
 _TOKEN = re.compile(r"""
     (?P<email>[\w.+-]+@[\w-]+(?:\.[\w-]+)+)
-  | (?P<url>(?:https?://|www\.)[^\s]+)
+  | (?P<url>(?:https?://|www\.)\S*[^\s.,;:!?)"'])
   | (?P<money>[$£€]\d[\d,]*(?:\.\d+)?)
-  | (?P<time>\d{1,2}:\d{2}(?:\s?[ap]\.?m\.?)?)
+  | (?P<time>\d{1,2}:\d{2}(?:\s?[ap]\.?m\b\.?)?)
+  | (?P<decade>\d{3}0s\b|'\d0s\b)
   | (?P<ordinal>\d+(?:st|nd|rd|th)\b)
   | (?P<number>-?\d[\d,]*(?:\.\d+)?%?)
-  | (?P<word>[^\W\d_](?:[^\W\d_]|['’](?=[^\W\d_]))*\.?(?:[^\W\d_]\.)*)
+  | (?P<word>[^\W\d_](?:[^\W\d_]|['’](?=[^\W\d_]))*(?:\.(?!\.))?(?:[^\W\d_]\.(?!\.))*)
   | (?P<dash>\s-\s|--+|[—–])
   | (?P<ellipsis>\.\.\.+|…)
   | (?P<para>\n\s*\n)
@@ -97,7 +98,12 @@ def say_ordinal(n: int) -> list[str]:
     return words
 
 
-def say_number(text: str) -> list[str]:
+YEAR_CONTEXT = frozenset({"year", "in", "since", "until", "by", "of", "from", "to"})
+
+
+def say_number(text: str, year_context: bool = False) -> list[str]:
+    """Cardinal, decimal, negative, percentage; 4-digit numbers 1100-2099 read as years
+    (1000-1099 too after words like "year" or "in")."""
     neg = text.startswith("-")
     body = text.lstrip("-").replace(",", "")
     pct = body.endswith("%")
@@ -105,8 +111,8 @@ def say_number(text: str) -> list[str]:
     whole, _, frac = body.partition(".")
     if len(whole) > MAX_CARDINAL_DIGITS:
         words = say_digits(whole)
-    elif not frac and not pct and not neg and len(whole) == 4 and 1100 <= int(whole) <= 2099 \
-            and "," not in text:
+    elif not frac and not pct and not neg and len(whole) == 4 and "," not in text and (
+            1100 <= int(whole) <= 2099 or (year_context and 1000 <= int(whole) <= 2099)):
         words = say_year(int(whole))
     else:
         words = say_cardinal(int(whole or "0"))
@@ -140,6 +146,7 @@ def normalize(text: str, *, max_chars: int = 5000,
     for m in _TOKEN.finditer(text):
         kind, s = m.lastgroup, m.group()
         toks: list[Token] = []
+        ends_sentence = _ends_sentence(text, m.end())
         if kind == "email":
             user, _, domain = s.partition("@")
             toks = _read_parts(user, s) + [WordToken("at", s)] + _read_parts(domain, s)
@@ -150,9 +157,11 @@ def normalize(text: str, *, max_chars: int = 5000,
             unit = CURRENCY[s[0]]
             whole, _, cents = s[1:].replace(",", "").partition(".")
             w = int(whole) if len(whole) <= MAX_CARDINAL_DIGITS else 0
+            c = int(cents[:2].ljust(2, "0")) if cents else 0
             words = say_cardinal(w) + [unit[0] if w == 1 else unit[1]]
-            if cents and int(cents[:2].ljust(2, "0")):
-                c = int(cents[:2].ljust(2, "0"))
+            if c and w == 0:
+                words = say_cardinal(c) + [unit[2] if c == 1 else unit[3]]
+            elif c:
                 words += ["and", *say_cardinal(c), unit[2] if c == 1 else unit[3]]
             toks = [WordToken(x, s) for x in words]
         elif kind == "time":
@@ -167,15 +176,28 @@ def normalize(text: str, *, max_chars: int = 5000,
                 words += [ampm.group(1), "m"]
             toks = [WordToken(x.replace("'", "") if x != "o'clock" else "o'clock", s,
                               is_letter=x in ("a", "p", "m") and bool(ampm)) for x in words]
+            if s.endswith(".") and ends_sentence:
+                toks.append(BreakToken(BreakKind.PERIOD))
+        elif kind == "decade":
+            digits = s.strip("'s")
+            if len(digits) == 2:  # '90s
+                words = say_cardinal(int(digits))
+            elif digits.endswith("00"):
+                words = say_cardinal(int(digits[:2])) + ["hundred"]
+            else:
+                words = say_year(int(digits))
+            last = words[-1]
+            words[-1] = last[:-1] + "ies" if last.endswith("y") else last + "s"
+            toks = [WordToken(x, s) for x in words]
         elif kind == "ordinal":
             digits = s[:-2]
             words = say_ordinal(int(digits)) if len(digits) <= MAX_CARDINAL_DIGITS \
                 else say_digits(digits)
             toks = [WordToken(x, s) for x in words]
         elif kind == "number":
-            toks = [WordToken(x, s) for x in say_number(s)]
+            toks = [WordToken(x, s) for x in say_number(s, prev_word in YEAR_CONTEXT)]
         elif kind == "word":
-            toks = _word(s, prev_word, is_word)
+            toks = _word(s, prev_word, is_word, _next_capitalised(text, m.end()), ends_sentence)
         elif kind == "dash":
             toks = [BreakToken(BreakKind.DASH)]
         elif kind == "ellipsis":
@@ -199,7 +221,19 @@ def normalize(text: str, *, max_chars: int = 5000,
 MAX_WORD_LETTERS = 40
 
 
-def _word(s: str, prev: str, is_word: Callable[[str], bool] | None) -> list[Token]:
+def _ends_sentence(text: str, end: int) -> bool:
+    """After an abbreviation's period: end of text, or a capitalised word follows."""
+    rest = text[end:end + 40].lstrip()
+    return not rest or rest[0].isupper() or rest[0] in "\n"
+
+
+def _next_capitalised(text: str, end: int) -> bool:
+    rest = text[end:end + 40].lstrip(" \t")
+    return bool(rest) and rest[0].isupper()
+
+
+def _word(s: str, prev: str, is_word: Callable[[str], bool] | None, next_cap: bool = False,
+          ends_sentence: bool = False) -> list[Token]:
     trailing_period = s.endswith(".") and s.count(".") == 1
     core = s[:-1] if trailing_period else s
     ascii_core = unicodedata.normalize("NFKD", core).encode("ascii", "ignore").decode()
@@ -214,14 +248,21 @@ def _word(s: str, prev: str, is_word: Callable[[str], bool] | None) -> list[Toke
             toks = [WordToken(x, s) for x in ABBREVIATIONS[key].split()]
         else:
             toks = _spell(low.replace(".", ""), s)
+        if s.endswith(".") and ends_sentence and key not in ("e.g", "i.e"):
+            toks.append(BreakToken(BreakKind.PERIOD))
         return toks
     if trailing_period and low in ABBREVIATIONS:
-        if low in STREET_AFTER and prev and prev[0:1].isalpha() and core[0].isupper() \
-                and prev not in ("the",):
-            words = STREET_AFTER[low] if not _next_is_name(prev) else ABBREVIATIONS[low]
-        else:
-            words = ABBREVIATIONS[low]
-        return [WordToken(x, s) for x in words.split()]
+        if low in STREET_AFTER and not next_cap:
+            # "Elm Dr." / "Mary St.": a street when no name follows
+            toks = [WordToken(x, s) for x in STREET_AFTER[low].split()]
+            if ends_sentence:
+                toks.append(BreakToken(BreakKind.PERIOD))
+            return toks
+        toks = [WordToken(x, s) for x in ABBREVIATIONS[low].split()]
+        title = low in ("mr", "mrs", "ms", "dr", "prof", "st", "mt", "no")
+        if ends_sentence and not (title and next_cap):
+            toks.append(BreakToken(BreakKind.PERIOD))
+        return toks
     if ascii_core.isupper() and len(ascii_core) > 1 and "'" not in ascii_core:
         known = is_word(low) if is_word else False
         if (known and len(low) > 3) or (not known and len(low) > 3 and _looks_pronounceable(low)):
@@ -238,15 +279,6 @@ def _word(s: str, prev: str, is_word: Callable[[str], bool] | None) -> list[Toke
     if trailing_period:
         toks.append(BreakToken(BreakKind.PERIOD))
     return toks
-
-
-def _next_is_name(prev: str) -> bool:
-    """'Dr.' before a name means doctor; after a street name it means Drive.
-
-    We only see the previous word: after a capitalised non-title word (Elm Dr.)
-    read the street sense; the caller checks capitalisation.
-    """
-    return prev in ("mister", "missus", "and", "with", "by", "to", "from", "at")
 
 
 def _read_parts(s: str, orth: str) -> list[Token]:

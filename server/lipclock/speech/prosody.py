@@ -50,7 +50,7 @@ from .tokens import BreakKind, BreakToken, Pronounced, PronouncedWord
 # Words per minute that the MITalk rules produce at PRCNT scale 1.0, measured on
 # varied prose with bench/bench_frontend.py --calibrate (articulation rate,
 # pauses excluded). rate_wpm scales segment durations relative to this.
-NATURAL_WPM = 185.0
+NATURAL_WPM = 182.0
 RATE_WPM_RANGE = (80.0, 450.0)
 PITCH_HZ_RANGE = (50.0, 400.0)
 MIN_SEGMENT_S = 0.015  # floor so every phone spans at least three 5 ms frames
@@ -258,7 +258,8 @@ def phrase_durations_s(phrase: _Phrase, scale: float) -> list[list[float]]:
             mn *= 0.5
             if vowel:
                 prcnt *= 0.5 if (pi != last_v and pi != first_v) else 0.7
-            elif b in _LIQ_GLIDE and pi + 1 < len(word.phones) and word.phones[pi + 1][-1].isdigit():
+            elif b in _LIQ_GLIDE and pi + 1 < len(word.phones) \
+                    and word.phones[pi + 1][-1].isdigit():
                 prcnt *= 0.1
             else:
                 prcnt *= 0.7

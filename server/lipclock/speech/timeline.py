@@ -9,14 +9,14 @@ Nothing here reads a clock or does I/O.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from enum import Enum
+from enum import StrEnum
 
 import numpy as np
 
 from .phoneset import PAUSE, base, stress
 
 
-class PhraseKind(str, Enum):
+class PhraseKind(StrEnum):
     """How a phrase ends; drives the final F0 movement and pause length."""
 
     STATEMENT = "statement"  # period: final fall

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
+from enum import StrEnum
 
 
-class BreakKind(str, Enum):
+class BreakKind(StrEnum):
     """Phrase breaks produced by punctuation, weakest to strongest roughly."""
 
     COMMA = "comma"

@@ -167,7 +167,8 @@ def _steady(tg: list[Target | None]) -> tuple[list[np.ndarray], list[np.ndarray]
     return starts, ends  # type: ignore[return-value]
 
 
-def _boundaries(cls: list[str], starts: list[np.ndarray], ends: list[np.ndarray]) -> list[np.ndarray]:
+def _boundaries(cls: list[str], starts: list[np.ndarray],
+                ends: list[np.ndarray]) -> list[np.ndarray]:
     """Formant values at each phone boundary (index i = start of phone i)."""
     n = len(cls)
     out = [starts[0]]
