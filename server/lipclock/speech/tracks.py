@@ -110,7 +110,11 @@ def _target_for(phone: str) -> Target:
 
 
 def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
-    """Frames (n, N_PARAMS) float32 covering the timeline; see klatt_params for columns."""
+    """Frames (n, N_PARAMS) float32 covering the timeline; see klatt_params for columns.
+
+    Per-phone quantities are built once, then spread over frames by each frame's
+    phone index, so the cost is a few numpy operations per utterance.
+    """
     sr = timeline.sample_rate
     n = kp.n_frames_for(timeline.num_samples, sr)
     fs = np.round(np.arange(n) * (sr / kp.FRAME_RATE_HZ)).astype(np.int64)
@@ -124,27 +128,23 @@ def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
     if not ph:
         return out.astype(np.float32)
     cls = [info(p.phone).cls for p in ph]
-    tg = [None if p.is_pause else _target_for(p.phone) for p in ph]
-    # HH takes the formants of what follows it
-    for i, p in enumerate(ph):
+    tg: list[Target | None] = [None if p.is_pause else _target_for(p.phone) for p in ph]
+    for i, p in enumerate(ph):  # HH takes the formants of what follows it
         if p.base == "HH":
             nxt = next((tg[j] for j in range(i + 1, len(ph)) if tg[j] is not None
                         and cls[j] in ("vowel", "diphthong", "glide", "liquid")), None)
-            if nxt is not None:
-                assert tg[i] is not None
+            if nxt is not None and tg[i] is not None:
                 tg[i] = Target("HH", tg[i].values, nxt.start.copy(), nxt.start.copy())
     starts, ends = _steady(tg)
     bounds = _boundaries(cls, starts, ends)
-    aspiration_until = [-1] * len(ph)
-    for i, p in enumerate(ph):
-        lo, hi = np.searchsorted(fs, [p.start, p.end])
-        if hi <= lo:
-            continue
-        t = (fs[lo:hi] - p.start) / sr
-        dur = max(p.num_samples / sr, 1e-3)
-        _formants(out, lo, hi, t, dur, starts[i], ends[i], bounds[i], bounds[i + 1], cls, i, ph)
-        _sources(out, lo, hi, t, dur, p.phone, cls, tg, i, ph, sr, aspiration_until)
-    _glottal_stops(out, fs, ph, cls)
+    n_ph = len(ph)
+    p_start = np.array([p.start for p in ph], dtype=np.int64)
+    p_end = np.array([p.end for p in ph], dtype=np.int64)
+    pidx = np.clip(np.searchsorted(p_end, fs, side="right"), 0, n_ph - 1)
+    t = (fs - p_start[pidx]) / sr
+    dur = np.maximum((p_end - p_start) / sr, 1e-3)[pidx]
+    _formants(out, t, dur, pidx, np.array(starts), np.array(ends), np.array(bounds), cls)
+    _sources(out, fs, t, dur, pidx, cls, tg, ph, sr)
     # smooth voicing onsets/offsets only (never AF/AH/A*: keeps bursts sharp)
     av = out[:, kp.AV].copy()
     out[1:-1, kp.AV] = 0.25 * av[:-2] + 0.5 * av[1:-1] + 0.25 * av[2:]
@@ -197,91 +197,93 @@ def _boundaries(cls: list[str], starts: list[np.ndarray],
     return out
 
 
-def _formants(out: np.ndarray, lo: int, hi: int, t: np.ndarray, dur: float, start: np.ndarray,
-              end: np.ndarray, lb: np.ndarray, rb: np.ndarray, cls: list[str], i: int,
-              ph: tuple) -> None:
-    c = cls[i]
+_FORMANT_COLS = [kp.F1, kp.F2, kp.F3, kp.B1, kp.B2, kp.B3, kp.FNZ]
+
+
+def _formants(out: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray,
+              starts: np.ndarray, ends: np.ndarray, bounds: np.ndarray, cls: list[str]) -> None:
+    """Steady targets (gliding for diphthongs) plus linear transitions from each boundary."""
+    n_ph = len(cls)
+    trans = np.array([_TRANS_S.get(c, 0.02) for c in cls])
+    after_closure = np.array([i > 0 and c in ("vowel", "diphthong")
+                              and cls[i - 1] in ("stop", "nasal", "affricate")
+                              for i, c in enumerate(cls)])
+    trans[after_closure] = 0.06  # CV transitions from stops/nasals are the long, audible ones
+    is_stop = np.array([c == "stop" for c in cls])
     x = np.clip((t / dur - 0.2) / 0.6, 0.0, 1.0)
-    glide = x * x * (3 - 2 * x)  # smoothstep between the diphthong's two targets
-    base = start[None, :] + (end - start)[None, :] * glide[:, None]
-    tr = min(_TRANS_S.get(c, 0.02), 0.5 * dur)
-    if c in ("vowel", "diphthong") and i > 0 and cls[i - 1] in ("stop", "nasal", "affricate"):
-        tr = min(0.06, 0.5 * dur)  # CV transitions from stops/nasals are the long, audible ones
-    if tr > 0:
-        wl = np.clip(1.0 - t / tr, 0.0, 1.0)[:, None]
-        wr = np.clip(1.0 - (dur - t) / tr, 0.0, 1.0)[:, None]
-        vals = base + (lb - start)[None, :] * wl + (rb - end)[None, :] * wr
-    else:
-        vals = base
-    if c in ("stop", "affricate"):
-        vals = np.repeat(((lb + rb) * 0.5)[None, :], hi - lo, axis=0) if c == "stop" else vals
-    cols = [kp.F1, kp.F2, kp.F3, kp.B1, kp.B2, kp.B3, kp.FNZ]
-    out[lo:hi, cols] = vals
+    glide = (x * x * (3 - 2 * x))[:, None]
+    s, e = starts[pidx], ends[pidx]
+    base = s + (e - s) * glide
+    tr = np.minimum(trans[pidx], 0.5 * dur)
+    safe = np.where(tr > 0, tr, 1.0)
+    wl = np.where(tr > 0, np.clip(1.0 - t / safe, 0.0, 1.0), 0.0)[:, None]
+    wr = np.where(tr > 0, np.clip(1.0 - (dur - t) / safe, 0.0, 1.0), 0.0)[:, None]
+    lb, rb = bounds[:n_ph][pidx], bounds[1:n_ph + 1][pidx]
+    vals = base + (lb - s) * wl + (rb - e) * wr
+    stop_f = is_stop[pidx]
+    vals[stop_f] = 0.5 * (lb[stop_f] + rb[stop_f])  # stops hold the locus mix (burst shape)
+    out[:, _FORMANT_COLS] = vals
 
 
 _PAR = (("AF", kp.AF), ("A2", kp.A2), ("A3", kp.A3), ("A4", kp.A4), ("A5", kp.A5),
         ("A6", kp.A6), ("AB", kp.AB))
+_SRC_COLS = [kp.AV, kp.AH] + [col for _, col in _PAR]
 
 
-def _sources(out: np.ndarray, lo: int, hi: int, t: np.ndarray, dur: float, phone: str,
-             cls: list[str], tg: list, i: int, ph: tuple, sr: int,
-             aspiration_until: list[int]) -> None:
-    c = cls[i]
-    tgt = tg[i]
-    if tgt is None:
-        return  # pause: all sources off
-    v = tgt.values
-    nxt = cls[i + 1] if i + 1 < len(cls) else "silence"
-    if c in ("vowel", "diphthong", "liquid", "glide", "nasal"):
-        av = v["AV"] - (3.0 if phone.endswith("0") else 0.0)
-        out[lo:hi, kp.AV] = av
-        if nxt == "silence" and c in ("vowel", "diphthong"):
-            fall = np.clip((t / dur - 0.6) / 0.4, 0.0, 1.0)
-            out[lo:hi, kp.AV] = av - 8.0 * fall  # phrase-final decay
-    elif c == "aspirate":
-        out[lo:hi, kp.AH] = v["AH"]
-    elif c == "fricative":
-        out[lo:hi, kp.AV] = v["AV"]
-        if phone in _HIGH_F6_HZ:
-            out[lo:hi, kp.F6] = _HIGH_F6_HZ[phone]
-        for name, col in _PAR:
-            out[lo:hi, col] = v[name]
-    elif c in ("stop", "affricate"):
-        voiced = info(phone).voiced
-        burst_s = _BURST_S.get(phone, 0.01) if c == "stop" else 0.5 * dur
-        in_burst = t >= dur - min(burst_s, 0.5 * dur)
-        if voiced and i > 0 and cls[i - 1] != "silence":
-            out[lo:hi, kp.AV] = np.where(in_burst, v["AV"], 38.0)  # voice bar in closure
-        release = nxt not in ("silence",)
-        weaker = 0.0 if release else 8.0
-        for name, col in _PAR:
-            out[lo:hi, col] = np.where(in_burst, max(0.0, v[name] - weaker) if v[name] else 0.0,
-                                       0.0)
-        if c == "affricate" and voiced:
-            out[lo:hi, kp.AV] = np.where(in_burst, v["AV"], 0.0)
-    # a voiceless stop before a voiced sound aspirates into the next phone
-    if info(phone).cls == "stop" and not info(phone).voiced and i + 1 < len(ph) \
-            and nxt in _SONORANT:
-        nxt_ph = ph[i + 1]
-        stressed = nxt_ph.phone[-1:] in ("1", "2")
-        vot_s = 0.055 if stressed else 0.035
-        vot = min(int(vot_s * sr), nxt_ph.num_samples // 2)
-        aspiration_until[i + 1] = nxt_ph.start + vot
-    if aspiration_until[i] > 0:
-        fs_here = ph[i].start + (t * sr).astype(np.int64)
-        asp = fs_here < aspiration_until[i]
-        out[lo:hi, kp.AH] = np.where(asp, 58.0, out[lo:hi, kp.AH])
-        out[lo:hi, kp.AV] = np.where(asp, 0.0, out[lo:hi, kp.AV])
-
-
-def _glottal_stops(out: np.ndarray, fs: np.ndarray, ph: tuple, cls: list[str]) -> None:
-    """Vowel-initial words after a pause or a vowel start with a brief AV dip (glottal stop)."""
-    for i in range(1, len(ph)):
-        p = ph[i]
-        if cls[i] not in ("vowel", "diphthong") or p.word < 0:
+def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
+             pidx: np.ndarray, cls: list[str], tg: list[Target | None], ph: tuple,
+             sr: int) -> None:
+    """Source amplitudes: per-phone closure and burst rows, then masks for bursts,
+    aspiration, phrase-final decay and glottal stops."""
+    n_ph = len(ph)
+    closure = np.zeros((n_ph, len(_SRC_COLS)))  # AV AH AF A2..A6 AB
+    burst = np.zeros((n_ph, len(_SRC_COLS)))
+    burst_s = np.zeros(n_ph)
+    final_decay = np.zeros(n_ph, dtype=bool)
+    asp_until = np.full(n_ph, -1, dtype=np.int64)
+    glottal = np.zeros(n_ph, dtype=bool)
+    high_f6 = np.zeros(n_ph)
+    for i, p in enumerate(ph):
+        tgt = tg[i]
+        if tgt is None:
             continue
-        if ph[i - 1].word == p.word:
-            continue
-        if cls[i - 1] in ("vowel", "diphthong", "silence"):
-            lo, hi = np.searchsorted(fs, [p.start, p.start + (p.end - p.start) // 4])
-            out[lo:hi, kp.AV] -= 12.0
+        v, c = tgt.values, cls[i]
+        nxt = cls[i + 1] if i + 1 < n_ph else "silence"
+        if c in _SONORANT:
+            closure[i, 0] = v["AV"] - (3.0 if p.phone.endswith("0") else 0.0)
+            final_decay[i] = nxt == "silence" and c in ("vowel", "diphthong")
+        elif c == "aspirate":
+            closure[i, 1] = v["AH"]
+        elif c == "fricative":
+            closure[i, 0] = v["AV"]
+            closure[i, 2:] = [v[name] for name, _ in _PAR]
+            high_f6[i] = _HIGH_F6_HZ.get(p.phone, 0.0)
+        elif c in ("stop", "affricate"):
+            voiced = info(p.phone).voiced
+            burst_s[i] = _BURST_S.get(p.phone, 0.01) if c == "stop" else 0.5
+            weaker = 0.0 if nxt != "silence" else 8.0
+            burst[i, 2:] = [max(0.0, v[name] - weaker) if v[name] else 0.0 for name, _ in _PAR]
+            burst[i, 0] = v["AV"]
+            if voiced and c == "stop" and i > 0 and cls[i - 1] != "silence":
+                closure[i, 0] = 38.0  # voice bar during the closure
+        # a voiceless stop before a voiced sound aspirates into the next phone
+        if c == "stop" and not info(p.phone).voiced and nxt in _SONORANT:
+            nxt_ph = ph[i + 1]
+            vot_s = 0.055 if nxt_ph.phone[-1:] in ("1", "2") else 0.035
+            asp_until[i + 1] = nxt_ph.start + min(int(vot_s * sr), nxt_ph.num_samples // 2)
+        # vowel-initial word after a pause or a vowel: brief glottal-stop dip
+        glottal[i] = (c in ("vowel", "diphthong") and p.word >= 0 and i > 0
+                      and ph[i - 1].word != p.word
+                      and cls[i - 1] in ("vowel", "diphthong", "silence"))
+    bl = np.minimum(burst_s[pidx], 0.5 * dur)
+    in_burst = (burst_s[pidx] > 0) & (t >= dur - bl)
+    vals = np.where(in_burst[:, None], burst[pidx], closure[pidx])
+    fall = np.clip((t / dur - 0.6) / 0.4, 0.0, 1.0)
+    vals[:, 0] -= np.where(final_decay[pidx], 8.0 * fall, 0.0)  # phrase-final decay
+    asp = fs < asp_until[pidx]
+    vals[asp, 0] = 0.0
+    vals[asp, 1] = 58.0
+    vals[:, 0] -= np.where(glottal[pidx] & (t < 0.25 * dur), 12.0, 0.0)
+    out[:, _SRC_COLS] = vals
+    f6 = high_f6[pidx]
+    out[:, kp.F6] = np.where(f6 > 0, f6, out[:, kp.F6])
