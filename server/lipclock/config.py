@@ -26,3 +26,16 @@ class Settings(BaseSettings):
     # --- server ---
     host: str = "127.0.0.1"
     port: int = 8000
+    speak_keys: list[str] = Field(default_factory=list,
+                                  description="API keys that may make a channel talk")
+    view_keys: list[str] = Field(default_factory=list, description="API keys that may only watch")
+    allowed_origins: list[str] = Field(default_factory=list,
+                                       description="WebSocket Origin allow-list (empty: any)")
+    max_message_bytes: int = Field(65536, ge=256, description="Largest WebSocket message")
+    max_client_queue: int = Field(1024, ge=8, description="Messages buffered per client")
+    max_queued_utterances: int = Field(8, ge=1, description="Utterances waiting per channel")
+    utterance_store: int = Field(64, ge=1, description="Recent utterances kept for download")
+
+    @property
+    def auth_enabled(self) -> bool:
+        return bool(self.speak_keys or self.view_keys)

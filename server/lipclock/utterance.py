@@ -12,7 +12,7 @@ import wave
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 
@@ -31,9 +31,10 @@ class AudioChunk:
         return self.start_sample + len(self.samples)
 
 
-def write_wav(path: str | Path, samples: np.ndarray, sample_rate: int) -> None:
-    """Write mono 16-bit PCM."""
-    with wave.open(str(path), "wb") as w:
+def write_wav(path: str | Path | BinaryIO, samples: np.ndarray, sample_rate: int) -> None:
+    """Write mono 16-bit PCM to a path or a binary file object."""
+    target = str(path) if isinstance(path, (str, Path)) else path
+    with wave.open(target, "wb") as w:
         w.setnchannels(1)
         w.setsampwidth(2)
         w.setframerate(sample_rate)
@@ -44,7 +45,7 @@ def wav_bytes(samples: np.ndarray, sample_rate: int) -> bytes:
     import io
 
     buf = io.BytesIO()
-    write_wav(buf, samples, sample_rate)  # type: ignore[arg-type]
+    write_wav(buf, samples, sample_rate)
     return buf.getvalue()
 
 

@@ -1,0 +1,329 @@
+"""The HTTP/WebSocket server: a thin edge that turns wire messages into core calls.
+
+Routes: POST /speak, GET /voices, /healthz, /metrics, /utterances/{id}.wav,
+/utterances/{id}/marks.json, / and /kiosk (the browser client), WebSocket /ws.
+Synthesis runs in worker threads so the event loop stays responsive.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import re
+import time
+from pathlib import Path
+from typing import Any
+
+from fastapi import FastAPI, Header, Request, WebSocket
+from fastapi.responses import FileResponse, JSONResponse, PlainTextResponse, Response
+from pydantic import BaseModel, Field, ValidationError
+from starlette.websockets import WebSocketDisconnect
+
+import lipclock
+
+from ..config import Settings
+from ..errors import LipclockError
+from ..face.models import MOUTH_MODELS
+from ..speech.voices import get_voice, voice_names
+from ..utterance import Prepared, wav_bytes
+from .channels import (
+    CLOSE_TOO_SLOW,
+    Broker,
+    ChannelBusy,
+    Job,
+    Subscriber,
+    UtteranceStore,
+    next_utterance_id,
+    summary,
+)
+from .metrics import Metrics
+from .protocol import (
+    CLIENT_MESSAGE,
+    CLIENT_TYPES,
+    Error,
+    Hello,
+    Ping,
+    Pong,
+    Speak,
+    Stop,
+    TextAppend,
+    TextFlush,
+)
+
+log = logging.getLogger("lipclock.server")
+CLIENT_DIR = Path(__file__).resolve().parents[3] / "client"
+CHANNEL_RE = re.compile(r"^[A-Za-z0-9_.-]{1,64}$")
+SENTENCE_END = re.compile(r"(?<=[.!?])[\"')\]]*\s+")
+
+
+class SpeakRequest(BaseModel):
+    text: str = Field(min_length=1)
+    voice: str | None = None
+    rate_wpm: float | None = None
+    pitch_hz: float | None = None
+    channel: str = "default"
+    mouth_model: str | None = None
+
+
+def _error(status: int, code: str, reason: str) -> JSONResponse:
+    return JSONResponse({"error": {"code": code, "reason": reason}}, status_code=status)
+
+
+def create_app(settings: Settings | None = None) -> FastAPI:
+    s = settings or Settings()
+    app = FastAPI(title="lipclock", version=lipclock.__version__,
+                  description="Text-to-speech with a talking face, stamped on the audio clock.")
+    broker = Broker(s.max_queued_utterances)
+    store = UtteranceStore(s.utterance_store)
+    metrics = Metrics()
+    app.state.broker, app.state.store, app.state.metrics = broker, store, metrics
+
+    def scope_of(key: str | None) -> str | None:
+        """'speak', 'view' or None (no valid key). Open server: everyone may speak."""
+        if not s.auth_enabled:
+            return "speak"
+        if key and key in s.speak_keys:
+            return "speak"
+        if key and key in s.view_keys:
+            return "view"
+        return None
+
+    async def prepare(text: str, voice: str | None, rate: float | None, pitch: float | None,
+                      model: str | None) -> Prepared:
+        t0 = time.perf_counter()
+        prep = await asyncio.to_thread(lipclock.prepare, text, voice=voice, rate_wpm=rate,
+                                       pitch_hz=pitch, mouth_model=model, settings=s)
+        metrics.observe_prepare(time.perf_counter() - t0, prep.duration_s)
+        return prep
+
+    @app.exception_handler(LipclockError)
+    async def _lipclock_error(_: Request, exc: LipclockError) -> JSONResponse:
+        metrics.error(exc.code)
+        return _error(400, exc.code, exc.reason)
+
+    @app.post("/speak", summary="Speak text on a channel",
+              responses={200: {"content": {"audio/wav": {}}}})
+    async def speak(req: SpeakRequest, request: Request, accept: str | None = Header(None),
+                    x_api_key: str | None = Header(None),
+                    authorization: str | None = Header(None)) -> Response:
+        key = x_api_key or (authorization[7:] if authorization and
+                            authorization.lower().startswith("bearer ") else None)
+        scope = scope_of(key)
+        if scope is None:
+            return _error(401, "unauthorized", "a valid API key is required (X-API-Key)")
+        if scope != "speak":
+            return _error(403, "forbidden", "this key may only view")
+        if not CHANNEL_RE.match(req.channel):
+            return _error(400, "bad_channel", "channel names are 1-64 of A-Z a-z 0-9 _ . -")
+        prep = await prepare(req.text, req.voice, req.rate_wpm, req.pitch_hz, req.mouth_model)
+        uid = next_utterance_id()
+        store.put(uid, prep)
+        try:
+            broker.channel(req.channel).enqueue(Job(uid, prep))
+        except ChannelBusy as exc:
+            return _error(429, "channel_busy", str(exc))
+        metrics.utterances += 1
+        base = str(request.base_url).rstrip("/")
+        marks_url = f"{base}/utterances/{uid}/marks.json"
+        if accept and "audio/wav" in accept:
+            audio = await asyncio.to_thread(lambda: prep.render().wav_bytes())
+            return Response(audio, media_type="audio/wav", headers={"X-Marks-URL": marks_url})
+        body = summary(uid, prep)
+        body.update(audio_url=f"{base}/utterances/{uid}.wav", marks_url=marks_url,
+                    channel=req.channel)
+        return JSONResponse(body)
+
+    @app.get("/voices")
+    async def voices() -> dict[str, Any]:
+        return {"voices": [{"name": n, "description": get_voice(n).description,
+                            "base_f0_hz": get_voice(n).base_f0_hz} for n in voice_names()],
+                "default": s.voice, "mouth_models": list(MOUTH_MODELS),
+                "sample_rate": s.sample_rate}
+
+    @app.get("/healthz")
+    async def healthz() -> dict[str, Any]:
+        return {"status": "ok", "version": lipclock.__version__,
+                "channels": len(broker.channels)}
+
+    @app.get("/metrics", response_class=PlainTextResponse)
+    async def prometheus() -> str:
+        return metrics.render(broker)
+
+    @app.get("/utterances/{uid}.wav")
+    async def utterance_wav(uid: int) -> Response:
+        prep = store.get(uid)
+        if prep is None:
+            return _error(404, "unknown_utterance", f"utterance {uid} is not (or no longer) kept")
+        audio = await asyncio.to_thread(lambda: wav_bytes(prep.render().samples,
+                                                          prep.sample_rate))
+        return Response(audio, media_type="audio/wav")
+
+    @app.get("/utterances/{uid}/marks.json")
+    async def utterance_marks(uid: int) -> Response:
+        prep = store.get(uid)
+        if prep is None:
+            return _error(404, "unknown_utterance", f"utterance {uid} is not (or no longer) kept")
+        return JSONResponse(prep.marks())
+
+    def client_file(name: str) -> Response:
+        path = (CLIENT_DIR / name).resolve()
+        if CLIENT_DIR.resolve() not in path.parents or not path.is_file():
+            return _error(404, "not_found", f"client file {name!r} not found")
+        return FileResponse(path)
+
+    @app.get("/", include_in_schema=False)
+    async def index() -> Response:
+        return client_file("index.html")
+
+    @app.get("/kiosk", include_in_schema=False)
+    async def kiosk() -> Response:
+        return client_file("kiosk.html")
+
+    @app.get("/client/{name:path}", include_in_schema=False)
+    async def client_static(name: str) -> Response:
+        return client_file(name)
+
+    @app.websocket("/ws")
+    async def ws(websocket: WebSocket) -> None:
+        await serve_socket(websocket, s, broker, store, metrics, scope_of, prepare)
+
+    return app
+
+
+async def serve_socket(websocket: WebSocket, s: Settings, broker: Broker, store: UtteranceStore,
+                       metrics: Metrics, scope_of: Any, prepare: Any) -> None:
+    """One WebSocket client: a sender task drains its queue; this loop reads its messages."""
+    origin = websocket.headers.get("origin")
+    if s.allowed_origins and origin not in s.allowed_origins:
+        await websocket.close(code=4003, reason="origin not allowed")
+        return
+    scope = scope_of(websocket.query_params.get("key"))
+    if scope is None:
+        await websocket.close(code=4001, reason="a valid key is required")
+        return
+    name = websocket.query_params.get("channel", "default")
+    if not CHANNEL_RE.match(name):
+        await websocket.close(code=4004, reason="bad channel name")
+        return
+    await websocket.accept()
+    metrics.connections += 1
+    sub = Subscriber(s.max_client_queue)
+    channel = broker.channel(name)
+    channel.subscribers.add(sub)
+    sender = asyncio.create_task(_send_loop(websocket, sub))
+    pending_text = ""
+
+    def reply(msg: Any) -> None:
+        sub.offer(msg.model_dump_json())
+
+    def fail(code: str, reason: str) -> None:
+        metrics.error(code)
+        reply(Error(code=code, reason=reason))
+
+    async def say(text: str, voice: str | None = None, rate: float | None = None,
+                  pitch: float | None = None, model: str | None = None) -> None:
+        try:
+            prep = await prepare(text, voice, rate, pitch, model)
+            uid = next_utterance_id()
+            store.put(uid, prep)
+            channel.enqueue(Job(uid, prep))
+            metrics.utterances += 1
+        except LipclockError as exc:
+            fail(exc.code, exc.reason)
+        except ChannelBusy as exc:
+            fail("channel_busy", str(exc))
+
+    reply(Hello(sample_rate=s.sample_rate, channel=name))
+    try:
+        while not sender.done():
+            msg = await websocket.receive()
+            if msg["type"] == "websocket.disconnect":
+                break
+            metrics.messages += 1
+            if msg.get("bytes") is not None:
+                fail("binary_not_expected", "send JSON text messages; binary is server->client")
+                continue
+            raw = msg.get("text") or ""
+            if len(raw.encode()) > s.max_message_bytes:
+                fail("too_large", f"message over {s.max_message_bytes} bytes")
+                continue
+            try:
+                data = json.loads(raw)
+            except json.JSONDecodeError as exc:
+                fail("bad_json", f"not JSON: {exc.msg} at {exc.pos}")
+                continue
+            if not isinstance(data, dict) or data.get("type") not in CLIENT_TYPES:
+                kind = data.get("type") if isinstance(data, dict) else type(data).__name__
+                fail("unknown_type", f"unknown message type {kind!r}; expected one of "
+                                     f"{', '.join(CLIENT_TYPES)}")
+                continue
+            try:
+                m = CLIENT_MESSAGE.validate_python(data)
+            except ValidationError as exc:
+                first = exc.errors()[0]
+                fail("bad_message", f"{data['type']}: {'.'.join(map(str, first['loc']))}: "
+                                    f"{first['msg']}")
+                continue
+            if isinstance(m, Ping):
+                reply(Pong(t_client=m.t_client, server_time_s=time.monotonic()))
+                continue
+            if scope != "speak":
+                fail("forbidden", "this key may only view")
+                continue
+            if isinstance(m, Speak):
+                await say(m.text, m.voice, m.rate_wpm, m.pitch_hz, m.mouth_model)
+            elif isinstance(m, TextAppend):
+                pending_text += m.text
+                if len(pending_text) > s.max_text_chars:
+                    pending_text = ""
+                    fail("text_too_long", f"buffered text over {s.max_text_chars} characters; "
+                                          "buffer cleared")
+                    continue
+                parts = SENTENCE_END.split(pending_text)
+                pending_text = parts.pop()
+                for sentence in parts:
+                    if sentence.strip():
+                        await say(sentence)
+            elif isinstance(m, TextFlush):
+                text, pending_text = pending_text, ""
+                if text.strip():
+                    await say(text)
+            elif isinstance(m, Stop):
+                channel.stop()
+    except WebSocketDisconnect:
+        pass
+    finally:
+        channel.subscribers.discard(sub)
+        sender.cancel()
+        await asyncio.gather(sender, return_exceptions=True)
+        metrics.connections -= 1
+        broker.drop_if_idle(name)
+
+
+async def _send_loop(websocket: WebSocket, sub: Subscriber) -> None:
+    while True:
+        item = await sub.queue.get()
+        if item is None:  # the client fell too far behind
+            await websocket.close(code=CLOSE_TOO_SLOW, reason="client too slow")
+            return
+        if isinstance(item, bytes):
+            await websocket.send_bytes(item)
+        else:
+            await websocket.send_text(item)
+
+
+def serve(settings: Settings) -> None:
+    """Run the server with uvicorn (embedded defaults: in-process channels, no services)."""
+    import uvicorn
+
+    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    if not settings.auth_enabled:
+        if settings.host not in ("127.0.0.1", "localhost", "::1"):
+            log.warning("no API keys configured: refusing to listen on %s; binding 127.0.0.1",
+                        settings.host)
+            settings = settings.model_copy(update={"host": "127.0.0.1"})
+        log.warning("no API keys configured: the server is open to anyone on this machine")
+    lipclock.synthesize("Ready.", settings=settings)  # load the lexicon, compile numba kernels
+    uvicorn.run(create_app(settings), host=settings.host, port=settings.port,
+                log_level="info", ws_max_size=settings.max_message_bytes * 2)
