@@ -1,0 +1,194 @@
+// lipclock client library (ES module, no build step).
+// Connects to a channel, plays streamed audio on an AudioContext, and tells a renderer,
+// on every animation frame, which audio-clock sample is being heard and the mouth state
+// at that sample. Protocol: docs/protocol.md (version 1).
+
+export const PROTOCOL_VERSION = 1;
+const HEADER_BYTES = 16;
+
+export class LipclockClient extends EventTarget {
+  constructor({ url, channel = "default", key = null, jitterBufferS = 0.12 } = {}) {
+    super();
+    const base = url || `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws`;
+    const q = new URLSearchParams({ channel });
+    if (key) q.set("key", key);
+    this.url = `${base}?${q}`;
+    this.jitterBufferS = jitterBufferS;
+    this.ctx = null;
+    this.utt = null;          // the utterance being played
+    this.backoffMs = 250;
+    this.closed = false;
+    this.debug = Object.freeze({ audioSample: 0, mouthSample: 0, lipGap: 0 });
+    this._connect();
+  }
+
+  // Browsers only let audio start after a user gesture: call this from a click handler.
+  async unlock() {
+    if (!this.ctx) this.ctx = new AudioContext({ latencyHint: "interactive" });
+    if (this.ctx.state !== "running") await this.ctx.resume();
+    this.dispatchEvent(new Event(this.ctx.state === "running" ? "audio-ready" : "audio-blocked"));
+    return this.ctx.state === "running";
+  }
+
+  send(msg) {
+    if (this.ws && this.ws.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify(msg));
+  }
+  speak(text, opts = {}) { this.send({ type: "speak", text, ...opts }); }
+  stop() { this.send({ type: "stop" }); }
+
+  close() { this.closed = true; if (this.ws) this.ws.close(); }
+
+  _connect() {
+    const ws = new WebSocket(this.url);
+    ws.binaryType = "arraybuffer";
+    this.ws = ws;
+    ws.onopen = () => { this.backoffMs = 250; this.dispatchEvent(new Event("open")); };
+    ws.onmessage = (ev) => {
+      try {
+        if (ev.data instanceof ArrayBuffer) this._onAudio(ev.data);
+        else this._onJson(JSON.parse(ev.data));
+      } catch (err) {
+        console.warn("lipclock: ignoring a malformed message:", err.message);
+      }
+    };
+    ws.onclose = () => {
+      this._silence("disconnected");
+      this.dispatchEvent(new Event("close"));
+      if (!this.closed) {           // reconnect with exponential backoff
+        setTimeout(() => this._connect(), this.backoffMs);
+        this.backoffMs = Math.min(this.backoffMs * 2, 8000);
+      }
+    };
+  }
+
+  _onJson(m) {
+    switch (m.type) {
+      case "hello":
+        if (m.protocol_version !== PROTOCOL_VERSION) {
+          console.warn(`lipclock: server speaks protocol ${m.protocol_version}, ` +
+                       `this client ${PROTOCOL_VERSION}; ignoring its messages`);
+          this.incompatible = true;
+        }
+        this.sampleRate = m.sample_rate;
+        break;
+      case "start":
+        if (this.incompatible) return;
+        this._silence("replaced");
+        this.utt = { id: m.utterance_id, sr: m.sample_rate, n: m.num_samples, start: m,
+                     t0: null, sources: [], frames: [], gap: [], rateHz: m.mouth_rate_hz,
+                     wordIdx: 0, ended: false, endSample: m.num_samples };
+        this.dispatchEvent(new CustomEvent("utterance-start", { detail: m }));
+        break;
+      case "mouth": {
+        const u = this.utt;
+        if (!u || u.id !== m.utterance_id) return;
+        m.frames.forEach((f, i) => { u.frames[m.first_frame + i] = f; u.gap[m.first_frame + i] = m.lip_gap[i]; });
+        break;
+      }
+      case "end": {
+        const u = this.utt;
+        if (!u || u.id !== m.utterance_id) return;
+        u.ended = true;
+        u.endSample = m.end_sample;
+        if (m.stopped) {
+          this._silence("stopped");
+          this.dispatchEvent(new CustomEvent("stop", { detail: m }));
+        }
+        break;
+      }
+      case "error":
+        console.warn(`lipclock: server error ${m.code}: ${m.reason}`);
+        this.dispatchEvent(new CustomEvent("server-error", { detail: m }));
+        break;
+      case "pong": break;
+      default:
+        console.warn("lipclock: unknown message type", m.type);
+    }
+  }
+
+  _onAudio(buf) {
+    const u = this.utt;
+    if (!u || !this.ctx || buf.byteLength < HEADER_BYTES) return;
+    const dv = new DataView(buf);
+    const magic = String.fromCharCode(dv.getUint8(0), dv.getUint8(1), dv.getUint8(2), dv.getUint8(3));
+    if (magic !== "LCA1") { console.warn("lipclock: bad audio frame"); return; }
+    const id = dv.getUint32(4, true);
+    const first = Number(dv.getBigUint64(8, true));
+    if (id !== u.id) return;
+    const pcm = new Int16Array(buf, HEADER_BYTES);
+    const audio = this.ctx.createBuffer(1, pcm.length, u.sr);  // the browser resamples
+    const ch = audio.getChannelData(0);
+    for (let i = 0; i < pcm.length; i++) ch[i] = pcm[i] / 32768;
+    if (u.t0 === null) u.t0 = this.ctx.currentTime + this.jitterBufferS;
+    const src = this.ctx.createBufferSource();
+    src.buffer = audio;
+    src.connect(this.tap || this.ctx.destination);
+    const when = u.t0 + first / u.sr;
+    if (when < this.ctx.currentTime) {
+      // late chunk: play the part still in the future so the clock stays exact
+      const late = this.ctx.currentTime - when;
+      if (late < audio.duration) src.start(this.ctx.currentTime, late);
+    } else {
+      src.start(when);
+    }
+    u.sources.push(src);
+  }
+
+  _silence(why) {
+    const u = this.utt;
+    if (!u) return;
+    for (const s of u.sources) { try { s.stop(); } catch (_) { /* not started */ } }
+    u.sources = [];
+    u.silenced = why;
+  }
+
+  // The audio-clock sample being heard now (output latency compensated), or null.
+  currentSample() {
+    const u = this.utt;
+    if (!u || u.t0 === null || !this.ctx || u.silenced) return null;
+    const latency = (this.ctx.outputLatency || this.ctx.baseLatency || 0);
+    const s = Math.floor((this.ctx.currentTime - latency - u.t0) * u.sr);
+    if (s < 0 || s >= u.endSample) return null;
+    return s;
+  }
+
+  // Mouth state at a sample: interpolated node positions and lip gap.
+  mouthAt(sample) {
+    const u = this.utt;
+    if (!u || sample === null) return null;
+    const pos = sample * u.rateHz / u.sr;
+    const k = Math.floor(pos);
+    const a = u.frames[k], b = u.frames[k + 1] || a;
+    if (!a) return null;
+    const f = pos - k;
+    const nodes = a.map((p, i) => [p[0] + (b[i][0] - p[0]) * f, p[1] + (b[i][1] - p[1]) * f]);
+    const gap = (u.gap[k] ?? 0) + ((u.gap[k + 1] ?? u.gap[k] ?? 0) - (u.gap[k] ?? 0)) * f;
+    return { nodes, names: u.start.mouth_nodes, lipGap: gap, sample: Math.round(k * u.sr / u.rateHz + f * u.sr / u.rateHz) };
+  }
+
+  // Call render(state) on every animation frame with {sample, mouth, words}.
+  animate(render) {
+    const tick = () => {
+      const sample = this.currentSample();
+      const mouth = this.mouthAt(sample);
+      const u = this.utt;
+      if (u && sample !== null) {
+        const words = u.start.words;
+        while (u.wordIdx < words.length && words[u.wordIdx].start <= sample) {
+          this.dispatchEvent(new CustomEvent("word", { detail: words[u.wordIdx] }));
+          u.wordIdx++;
+        }
+      }
+      if (u && u.ended && sample === null && u.t0 !== null && !u.doneFired &&
+          this.ctx && this.ctx.currentTime > u.t0 + u.endSample / u.sr) {
+        u.doneFired = true;
+        this.dispatchEvent(new CustomEvent("utterance-end", { detail: { id: u.id } }));
+      }
+      this.debug = Object.freeze({ audioSample: sample ?? 0, mouthSample: mouth ? mouth.sample : 0,
+                                   lipGap: mouth ? mouth.lipGap : 0 });
+      render({ sample, mouth });
+      requestAnimationFrame(tick);
+    };
+    requestAnimationFrame(tick);
+  }
+}
