@@ -129,3 +129,29 @@ def test_cli_timeline(capsys):
     assert cli_main(["timeline", "Hi there."]) == 0
     out = capsys.readouterr().out
     assert "HH" in out and "pau" in out
+
+
+def _has_system_voice() -> bool:
+    from lipclock.speech.system_voice import system_voices
+
+    return "gmw/en-us" in system_voices()
+
+
+@pytest.mark.skipif(not _has_system_voice(), reason="no pyttsx3/eSpeak system voice here")
+def test_system_voice_through_the_whole_pipeline():
+    utt = lipclock.synthesize("Hello there, my friend.", voice="system:gmw/en-us")
+    assert utt.voice == "system:gmw/en-us"
+    assert len(utt.samples) == utt.timeline.num_samples
+    assert [w.text for w in utt.words] == ["hello", "there", "my", "friend"]
+    spoken = [p for p in utt.phones if not p.is_pause]
+    assert spoken and all(p.word >= 0 for p in spoken)  # every phone sits inside its word
+    prep = lipclock.prepare("Hello there, my friend.", voice="system:gmw/en-us")
+    joined = np.concatenate([c.samples for c in prep.audio_chunks()])
+    assert len(joined) == prep.num_samples and utt.mouth.measures["lip_gap"].max() > 3
+
+
+@pytest.mark.skipif(not _has_system_voice(), reason="no pyttsx3/eSpeak system voice here")
+def test_unknown_system_voice_lists_choices():
+    with pytest.raises(UnknownChoiceError) as info:
+        lipclock.synthesize("hi", voice="system:klingon")
+    assert "system:gmw/en-us" in info.value.reason

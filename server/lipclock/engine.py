@@ -35,15 +35,19 @@ FIRST_CHUNK_S = 0.05  # small first chunk: playback can start after ~1 ms of wor
 MAX_CHUNK_S = 0.4  # later chunks end at phrase boundaries or after this much audio
 
 
+SYSTEM_PREFIX = "system:"
+
+
 @dataclass(frozen=True)
 class Request:
     text: str
-    voice: Voice
+    voice: Voice  # Klatt voice (for system voices: the default, used for prosody only)
     prosody: ProsodySettings
     mouth_model: str
     mouth_rate_hz: float
     max_chars: int
     lexicon: Lexicon
+    system_voice: str | None = None  # "system:<id>": audio from pyttsx3's engine
 
 
 @dataclass(frozen=True)
@@ -55,6 +59,7 @@ class Work:
     visemes: tuple[Any, ...] = ()
     mouth: Any = None
     frames: np.ndarray | None = None
+    samples: np.ndarray | None = None  # set when audio comes from a system voice
 
 
 def _normalize(w: Work) -> Work:
@@ -98,6 +103,41 @@ STAGES: tuple[Stage, ...] = (
 )
 
 
+def _system_voice(w: Work) -> Work:
+    """Audio and event-timed phones from the platform engine (speech/system_voice.py)."""
+    from .speech.phoneset import PAUSE
+    from .speech.system_voice import synthesize_system
+    from .speech.timeline import F0Point, PhoneSpan, Timeline, WordSpan
+
+    r = w.request
+    if len(r.text) > r.max_chars:
+        from .errors import TextTooLongError
+
+        raise TextTooLongError(len(r.text), r.max_chars)
+    assert r.system_voice is not None
+    out = synthesize_system(r.text, r.system_voice, r.prosody.sample_rate,
+                            round(r.prosody.rate_wpm))
+    words = tuple(WordSpan(t, a, b, t, "system") for t, a, b in out.words)
+    starts = [wd.start for wd in words]
+    phones = []
+    for ph, a, b in out.phones:
+        wi = -1
+        if ph != PAUSE and starts:
+            j = int(np.searchsorted(starts, a, side="right")) - 1
+            wi = j if j >= 0 and a < words[j].end else -1
+        phones.append(PhoneSpan(ph, a, b, wi))
+    timeline = Timeline(out.sample_rate, tuple(phones), words,
+                        (F0Point(0, r.prosody.base_f0_hz),))
+    return replace(w, timeline=timeline, samples=out.samples)
+
+
+SYSTEM_STAGES: tuple[Stage, ...] = (
+    ("system_voice", _system_voice),
+    ("visemes", _visemes),
+    ("mouth", _mouth),
+)
+
+
 def run_stages(work: Work, stages: tuple[Stage, ...] = STAGES) -> Work:
     for _name, stage in stages:
         work = stage(work)
@@ -109,6 +149,9 @@ def make_request(text: str, *, voice: str | None = None, rate_wpm: float | None 
                  settings: Settings | None = None, lexicon: Lexicon | None = None) -> Request:
     """Resolve the caller's options against Settings and the voice; validate ranges."""
     s = settings or Settings()
+    system = None
+    if voice and voice.startswith(SYSTEM_PREFIX):
+        system, voice = voice, None
     if s.sample_rate not in SUPPORTED_SAMPLE_RATES:
         raise OutOfRangeError("sample_rate", s.sample_rate, min(SUPPORTED_SAMPLE_RATES),
                               max(SUPPORTED_SAMPLE_RATES))
@@ -126,7 +169,7 @@ def make_request(text: str, *, voice: str | None = None, rate_wpm: float | None 
         period_pause_s=s.period_pause_s,
     )
     return Request(text, v, prosody, mouth_model or s.mouth_model, s.mouth_rate_hz,
-                   s.max_text_chars, lexicon or _lexicon_for(s))
+                   s.max_text_chars, lexicon or _lexicon_for(s), system)
 
 
 def _checked_rate(wpm: float) -> float:
@@ -177,7 +220,14 @@ def chunk_bounds(timeline: Timeline, first_chunk_s: float = FIRST_CHUNK_S,
 
 def render_chunks(work: Work) -> Iterator[tuple[int, np.ndarray]]:
     """Yield ``(start_sample, int16 samples)`` covering the utterance exactly once, in order."""
-    assert work.timeline is not None and work.frames is not None
+    assert work.timeline is not None
+    if work.samples is not None:  # system voice: the audio exists already
+        start = 0
+        for end in chunk_bounds(work.timeline):
+            yield start, work.samples[start:end]
+            start = end
+        return
+    assert work.frames is not None
     r = work.request
     renderer = klatt.KlattRenderer(work.frames, r.prosody.sample_rate, r.voice, seed=0)
     start = 0
@@ -188,7 +238,9 @@ def render_chunks(work: Work) -> Iterator[tuple[int, np.ndarray]]:
 
 
 def prepare_work(text: str, **options: Any) -> Work:
-    return run_stages(Work(make_request(text, **options)))
+    request = make_request(text, **options)
+    stages = SYSTEM_STAGES if request.system_voice else STAGES
+    return run_stages(Work(request), stages)
 
 
 def default_lexicon_warm() -> None:

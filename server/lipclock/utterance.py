@@ -133,7 +133,8 @@ class Prepared(_Marks):
     @classmethod
     def from_work(cls, text: str, work: Work) -> Prepared:
         assert work.timeline is not None
-        return cls(text, work.request.voice.name, work.timeline, work.visemes, work.mouth, work)
+        voice = work.request.system_voice or work.request.voice.name
+        return cls(text, voice, work.timeline, work.visemes, work.mouth, work)
 
     def audio_chunks(self) -> Iterator[AudioChunk]:
         """Audio in order; the chunks concatenate to exactly :meth:`render`'s samples."""

@@ -25,6 +25,7 @@ import lipclock
 from ..config import Settings
 from ..errors import LipclockError
 from ..face.models import MOUTH_MODELS
+from ..speech.system_voice import system_voices
 from ..speech.voices import get_voice, voice_names
 from ..utterance import Prepared, wav_bytes
 from .channels import (
@@ -138,6 +139,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     async def voices() -> dict[str, Any]:
         return {"voices": [{"name": n, "description": get_voice(n).description,
                             "base_f0_hz": get_voice(n).base_f0_hz} for n in voice_names()],
+                "system_voices": ["system:" + v for v in system_voices()],
                 "default": s.voice, "mouth_models": list(MOUTH_MODELS),
                 "sample_rate": s.sample_rate}
 
