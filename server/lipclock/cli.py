@@ -57,8 +57,8 @@ def _add_say(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     p.add_argument("-o", "--output", required=True, help="output WAV path")
     p.add_argument("--marks", help="write the marks JSON (words, phones, visemes, mouth) here")
     p.add_argument("--format", dest="export_format", default=None,
-                   help="add a mouth export to the marks: oculus|azure|arkit|rhubarb-json|"
-                        "rhubarb-tsv")
+                   choices=["oculus", "azure", "arkit", "rhubarb-json", "rhubarb-tsv"],
+                   help="add a mouth export to the marks (under 'export')")
     p.add_argument("--voice", default=None)
     p.add_argument("--rate", type=float, default=None, help="words per minute (80-450)")
     p.add_argument("--pitch", type=float, default=None, help="base pitch in Hz (50-400)")
