@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import statistics
 import time
+from itertools import pairwise
 
 import numpy as np
 
@@ -83,7 +84,7 @@ def max_speed_mm_s(track) -> float:
 def viseme_rates(tl) -> tuple[float, float]:
     ev = visemes_for(tl)
     dur_s = tl.num_samples / tl.sample_rate
-    raw = sum(1 for a, b in zip(ev, ev[1:]) if a.viseme != b.viseme)
+    raw = sum(1 for a, b in pairwise(ev) if a.viseme != b.viseme)
     hold = round(HOLD_S * tl.sample_rate)
     held: list[str] = []
     for e in ev:

@@ -7,6 +7,7 @@ stage independently of the front end's durations.
 from __future__ import annotations
 
 import math
+from itertools import pairwise
 
 import numpy as np
 import pytest
@@ -145,7 +146,7 @@ def test_visemes_cover_the_timeline() -> None:
     tl = mom(1.0)
     ev = visemes_for(tl)
     assert ev[0].start == 0 and ev[-1].end == tl.num_samples
-    assert all(a.end == b.start and a.viseme != b.viseme for a, b in zip(ev, ev[1:]))
+    assert all(a.end == b.start and a.viseme != b.viseme for a, b in pairwise(ev))
 
 
 def test_bad_shape_table_fails_with_file_line(tmp_path) -> None:
