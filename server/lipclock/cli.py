@@ -29,6 +29,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_say(sub)
     _add_phonemes(sub)
     _add_timeline(sub)
+    _add_plot(sub)
     return parser
 
 
@@ -143,6 +144,22 @@ def _timeline(args: argparse.Namespace, settings: Settings) -> int:
             print(f"{p.start}\t{p.end}\t{p.phone}\t{word}")
         else:
             print(f"{p.start / sr:.3f}\t{p.end / sr:.3f}\t{p.phone}\t{word}")
+    return 0
+
+
+def _add_plot(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    p = sub.add_parser("plot", help="draw waveform, phones and mouth trajectories to a PNG")
+    p.add_argument("text")
+    p.add_argument("-o", "--output", required=True, help="image path (.png, .svg, .pdf)")
+    p.add_argument("--rate", type=float, default=None)
+    p.add_argument("--voice", default=None)
+    p.set_defaults(handler=_plot)
+
+
+def _plot(args: argparse.Namespace, settings: Settings) -> int:
+    from .plot import plot_utterance
+
+    print(plot_utterance(args.text, args.output, rate_wpm=args.rate, voice=args.voice))
     return 0
 
 
