@@ -173,13 +173,12 @@ def spring_nodes(timeline: Timeline, rate_hz: float, d: Dynamics) -> np.ndarray:
 @njit(cache=True, nogil=True)
 def _integrate(vis_idx, targets, closure, rest, mass, k, c, k_cl, c_cl, lips, edges, k_nb,
                lip_pairs, dt, frame_pos):  # type: ignore[no-untyped-def]
-    """Step the mesh; record node positions at ``frame_pos`` (in steps), interpolated
-    between the two steps around each frame."""
+    """Step the mesh; record node positions at the first step at or after each frame
+    (``frame_pos`` in steps; at most half a step, 1 ms, from the frame's sample)."""
     n_steps = vis_idx.shape[0]
     n = rest.shape[0]
     out = np.empty((frame_pos.shape[0], n, 2))
     fi = 0
-    prev = rest.copy()
     x = rest.copy()
     v = np.zeros((n, 2))
     f = np.zeros((n, 2))
@@ -212,15 +211,9 @@ def _integrate(vis_idx, targets, closure, rest, mass, k, c, k_cl, c_cl, lips, ed
                 vm = 0.5 * (v[lo, 1] + v[u, 1])
                 v[lo, 1] = vm
                 v[u, 1] = vm
-        while fi < frame_pos.shape[0] and frame_pos[fi] <= s:
-            frac = frame_pos[fi] - (s - 1) if s > 0 else 1.0
-            for i in range(n):
-                for a in range(2):
-                    out[fi, i, a] = prev[i, a] + (x[i, a] - prev[i, a]) * frac
+        while fi < frame_pos.shape[0] and frame_pos[fi] <= s + 0.5:
+            out[fi] = x
             fi += 1
-        for i in range(n):
-            for a in range(2):
-                prev[i, a] = x[i, a]
     while fi < frame_pos.shape[0]:  # frames past the last step hold the final pose
         out[fi] = x
         fi += 1
