@@ -23,7 +23,7 @@ from .spring import default_dynamics, load_dynamics, spring_nodes
 from .track import MouthTrack
 from .visemes import shapes, viseme_of
 
-MOUTH_MODELS = ("linear", "cosine", "spring")
+MOUTH_MODELS = ("linear", "cosine", "spring", "bigram")
 
 def _targets(timeline: Timeline) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Per phone: centre sample, target measures (n, 4), viseme names."""
@@ -87,6 +87,11 @@ def mouth_for(timeline: Timeline, model: str = "spring", rate_hz: float = 100.0,
         d = default_dynamics() if not params else load_dynamics(
             package_file("lipclock.viseme_tables", "dynamics.toml"), params)
         nodes = spring_nodes(timeline, rate_hz, d)
+    elif model == "bigram":
+        from .bigram import bigram_measures
+
+        nodes = nodes_from_measures(bigram_measures(
+            timeline, _frame_samples(timeline, rate_hz), params))
     else:
         m = _interp(timeline, rate_hz, cosine=(model == "cosine"))
         m[:, 0] = np.maximum(m[:, 0], 0.0)
