@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from ..errors import OutOfRangeError, TableError, UnknownChoiceError
 from ..speech.phoneset import base, phones
@@ -147,6 +148,7 @@ def _closing(w: np.ndarray, width: int) -> np.ndarray:
     return win(np.pad(d, pad, mode="edge"), 2 * pad + 1).min(axis=1)
 
 
+@njit(cache=True, nogil=True)
 def _speed_limit(w: np.ndarray, step: float) -> np.ndarray:
     """Slope-limited dilation: every weight >= neighbour - step, both directions."""
     w = w.copy()
