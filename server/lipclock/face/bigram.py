@@ -138,6 +138,67 @@ def _character_curves(name: str, classes: dict[str, Any], curves: Curves) -> Cur
     return {**curves, **load_curves(folder / f"{name}.tsv", classes)}
 
 
+_PACK_CACHE: dict[int, tuple[Curves, tuple[np.ndarray, ...]]] = {}
+
+
+def _pack(keys: tuple[tuple[str, str], ...], curves: Curves,
+          pose_names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
+    """Curves as padded arrays for the compiled stitcher: pose ids, knot u, knot w, counts."""
+    hit = _PACK_CACHE.get(id(curves))
+    if hit is not None and hit[0] is curves:  # only the long-lived default set is cached
+        return hit[1]
+    n_pose = max(len(curves[k]) for k in keys)
+    n_knot = max(len(u) for k in keys for u, _ in curves[k].values())
+    pose_id = np.full((len(keys), n_pose), -1, np.int64)
+    ku = np.zeros((len(keys), n_pose, n_knot))
+    kw = np.zeros((len(keys), n_pose, n_knot))
+    nk = np.zeros((len(keys), n_pose), np.int64)
+    for i, k in enumerate(keys):
+        for j, (pose, (u, wt)) in enumerate(curves[k].items()):
+            pose_id[i, j] = pose_names.index(pose)
+            ku[i, j, :len(u)], kw[i, j, :len(u)], nk[i, j] = u, wt, len(u)
+    if curves is default_tables()[1]:
+        _PACK_CACHE[id(curves)] = (curves, (pose_id, ku, kw, nk))
+    return pose_id, ku, kw, nk
+
+
+@njit(cache=True, nogil=True)
+def _stitch(fs: np.ndarray, bounds: np.ndarray, ids: np.ndarray, pose_id: np.ndarray,
+            ku: np.ndarray, kw: np.ndarray, nk: np.ndarray, w: np.ndarray) -> None:
+    """Time-warp each phone pair's curves onto its frames and stitch by maximum (in place).
+
+    Pair i spans phones i and i+1: bounds[i]..bounds[i+2]; the left phone maps to
+    u in [0, 0.5), the right one to [0.5, 1].
+    """
+    k0 = 0
+    for i in range(ids.shape[0]):
+        a0, b0, b1 = bounds[i], bounds[i + 1], bounds[i + 2]
+        while k0 < fs.shape[0] and fs[k0] < a0:
+            k0 += 1
+        k = k0
+        while k < fs.shape[0] and fs[k] < b1:
+            t = fs[k]
+            if t < b0:
+                u = 0.5 * (t - a0) / max(b0 - a0, 1.0)
+            else:
+                u = 0.5 + 0.5 * (t - b0) / max(b1 - b0, 1.0)
+            for j in range(pose_id.shape[1]):
+                p = pose_id[ids[i], j]
+                if p < 0:
+                    continue
+                n = nk[ids[i], j]
+                m = 1
+                while m < n - 1 and ku[ids[i], j, m] < u:
+                    m += 1
+                u0, u1 = ku[ids[i], j, m - 1], ku[ids[i], j, m]
+                w0, w1 = kw[ids[i], j, m - 1], kw[ids[i], j, m]
+                x = min(max((u - u0) / (u1 - u0), 0.0), 1.0)
+                v = w0 + (w1 - w0) * x
+                if v > w[p, k]:
+                    w[p, k] = v
+            k += 1
+
+
 def _closing(w: np.ndarray, width: int) -> np.ndarray:
     """Grey-scale closing (max filter then min filter): fills dips narrower than width."""
     if width < 2:
@@ -184,17 +245,13 @@ def bigram_measures(timeline: Timeline, frame_samples: np.ndarray,
     fs = np.asarray(frame_samples, dtype=np.float64)
     w = np.zeros((len(pose_names), len(fs)))
     ph = timeline.phones
-    for a, b in zip(ph, ph[1:], strict=False):
-        lo, hi = np.searchsorted(fs, [a.start, b.end])
-        if hi <= lo:
-            continue
-        t = fs[lo:hi]
-        # time warp: left phone -> u in [0, 0.5), right phone -> [0.5, 1]
-        u = np.where(t < b.start, 0.5 * (t - a.start) / max(a.end - a.start, 1),
-                     0.5 + 0.5 * (t - b.start) / max(b.end - b.start, 1))
-        for pose, (ku, kw) in curves[(cls_of[base(a.phone)], cls_of[base(b.phone)])].items():
-            row = w[pose_index[pose], lo:hi]
-            np.maximum(row, np.interp(u, ku, kw), out=row)
+    keys = list(curves)
+    key_id = {k: i for i, k in enumerate(keys)}
+    packed = _pack(tuple(keys), curves, tuple(pose_names))
+    cls = [cls_of[base(p.phone)] for p in ph]
+    ids = np.array([key_id[(a, b)] for a, b in zip(cls, cls[1:], strict=False)], np.int64)
+    bounds = np.array([p.start for p in ph] + [ph[-1].end], dtype=np.float64)
+    _stitch(fs, bounds, ids, *packed, w)
     if len(ph) == 1:
         w[pose_index[classes[cls_of[base(ph[0].phone)]][0]]] = 1.0
     frame_s = float(np.median(np.diff(fs))) / timeline.sample_rate if len(fs) > 1 else 0.01
