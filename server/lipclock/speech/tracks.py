@@ -90,7 +90,7 @@ _DEFAULTS = {kp.F4: 3300.0, kp.F5: 3750.0, kp.F6: 4900.0, kp.B4: 250.0, kp.B5: 2
              kp.B6: 1000.0, kp.FNP: 270.0, kp.BNP: 100.0, kp.FNZ: 270.0, kp.BNZ: 100.0}
 # Release burst length by place: labial bursts are brief, velar ones long and
 # often double (Fant 1973; Stevens 1998, ch. 7).
-_BURST_S = {"P": 0.006, "B": 0.005, "T": 0.012, "D": 0.010, "K": 0.020, "G": 0.016}
+_BURST_S = {"P": 0.006, "B": 0.005, "T": 0.012, "D": 0.010, "K": 0.028, "G": 0.022}
 # /s z/ noise peaks above the default F6 (4.9 kHz): move the F6 pole up for them.
 _HIGH_F6_HZ = {"S": 6000.0, "Z": 6000.0}
 _SONORANT = {"vowel", "diphthong", "liquid", "glide", "nasal"}
@@ -136,7 +136,7 @@ def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
             if nxt is not None and tg[i] is not None:
                 tg[i] = Target("HH", tg[i].values, nxt.start.copy(), nxt.start.copy())
     starts, ends = _steady(tg)
-    bounds = _boundaries(cls, starts, ends)
+    bounds = _boundaries(cls, starts, ends, [p.base for p in ph])
     n_ph = len(ph)
     p_start = np.array([p.start for p in ph], dtype=np.int64)
     p_end = np.array([p.end for p in ph], dtype=np.int64)
@@ -167,10 +167,24 @@ def _steady(tg: list[Target | None]) -> tuple[list[np.ndarray], list[np.ndarray]
     return starts, ends  # type: ignore[return-value]
 
 
-def _boundaries(cls: list[str], starts: list[np.ndarray],
-                ends: list[np.ndarray]) -> list[np.ndarray]:
+_VELAR = frozenset({"K", "G", "NG"})
+
+
+def _velar_pinch(v: np.ndarray, vowel: np.ndarray) -> np.ndarray:
+    """Velar loci follow the vowel: F2 starts just above the vowel's F2 and F3 comes down
+    to meet it (the 'velar pinch', Stevens 1998 ch. 7)."""
+    out = v.copy()
+    f2 = float(np.clip(vowel[1] * 1.08 + 120.0, 1300.0, 2400.0))
+    out[1] = f2
+    out[2] = min(float(vowel[2]), f2 + 450.0)
+    return out
+
+
+def _boundaries(cls: list[str], starts: list[np.ndarray], ends: list[np.ndarray],
+                names: list[str] | None = None) -> list[np.ndarray]:
     """Formant values at each phone boundary (index i = start of phone i)."""
     n = len(cls)
+    names = names or [""] * n
     out = [starts[0]]
     for i in range(1, n):
         a, b = cls[i - 1], cls[i]
@@ -185,9 +199,13 @@ def _boundaries(cls: list[str], starts: list[np.ndarray],
             if a_cons and not b_cons:
                 k = _LOCUS_K.get(a, 0.5)
                 v = k * left + (1 - k) * right
+                if names[i - 1] in _VELAR:
+                    v = _velar_pinch(v, right)
             elif b_cons and not a_cons:
                 k = _LOCUS_K.get(b, 0.5)
                 v = k * right + (1 - k) * left
+                if names[i] in _VELAR:
+                    v = _velar_pinch(v, left)
             else:
                 v = 0.5 * (left + right)
             if a == "nasal" or b == "nasal":
