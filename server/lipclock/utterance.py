@@ -77,8 +77,10 @@ class _Marks:
     def words(self) -> tuple[WordSpan, ...]:
         return self.timeline.words
 
-    def marks(self, fmt: str | None = None) -> dict[str, Any]:
-        """The marks dict (DESIGN.md contract); ``fmt`` adds one export under ``export``."""
+    def marks(self, fmt: str | None = None, *, mouth: bool = True) -> dict[str, Any]:
+        """The marks dict (DESIGN.md contract); ``fmt`` adds one export under ``export``.
+
+        ``mouth=False`` leaves out the trajectories (cheap: for streaming headers)."""
         tl = self.timeline
         out: dict[str, Any] = {
             "sample_rate": tl.sample_rate,
@@ -90,8 +92,9 @@ class _Marks:
                         "word": p.word} for p in tl.phones],
             "visemes": [{"viseme": v.viseme, "phone": v.phone, "start": v.start, "end": v.end}
                         for v in self.visemes],
-            "mouth": self.mouth.to_marks(),
         }
+        if mouth:
+            out["mouth"] = self.mouth.to_marks()
         if fmt:
             from .face.exports import export
 

@@ -88,11 +88,18 @@ def load_dynamics(path: Path, overrides: dict[str, Any] | None = None) -> Dynami
     checked: dict[str, float] = {}
     for key, value in params.items():
         line = line_of(path, key.split(".")[-1])
-        v = finite_float(path, line, key, value)
         lo, hi = PARAM_RANGES[key.split(".")[-1]]
+        if overrides and key in overrides:  # the caller's value: an out-of-range error
+            try:
+                v = float(value)
+            except (TypeError, ValueError):
+                raise OutOfRangeError(key, value, lo, hi) from None
+            if not (math.isfinite(v) and lo <= v <= hi):
+                raise OutOfRangeError(key, value, lo, hi)
+            checked[key] = v
+            continue
+        v = finite_float(path, line, key, value)
         if not lo <= v <= hi:
-            if overrides and key in overrides:
-                raise OutOfRangeError(key, v, lo, hi)
             raise TableError(path, line, f"{key}={v} outside {lo}..{hi}")
         checked[key] = v
     mass, k, c = np.zeros(len(NODES)), np.zeros(len(NODES)), np.zeros(len(NODES))

@@ -125,7 +125,7 @@ class Channel:
 
 
 def start_message(uid: int, prep: Prepared) -> Start:
-    m = prep.marks()
+    m = prep.marks(mouth=False)
     return Start(utterance_id=uid, sample_rate=prep.sample_rate, num_samples=prep.num_samples,
                  text=prep.text, voice=prep.voice, words=m["words"], phones=m["phones"],
                  visemes=m["visemes"], mouth_nodes=list(prep.mouth.nodes),
@@ -179,7 +179,7 @@ class UtteranceStore:
 
 
 def summary(uid: int, prep: Prepared) -> dict[str, Any]:
-    m = prep.marks()
+    m = prep.marks(mouth=False)
     return {"utterance_id": uid, "sample_rate": prep.sample_rate,
             "duration_s": round(prep.duration_s, 4), "words": m["words"],
             "phones": m["phones"], "visemes": m["visemes"]}
