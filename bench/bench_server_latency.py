@@ -17,6 +17,7 @@ import time
 
 import httpx
 import websockets
+
 from serverutil import percentile, running_server
 
 SENTENCE = ("Please remember that the north elevators are closed for repairs today, so use "
