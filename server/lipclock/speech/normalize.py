@@ -43,11 +43,11 @@ BREAKS = {",": BreakKind.COMMA, ".": BreakKind.PERIOD, "?": BreakKind.QUESTION,
 _TOKEN = re.compile(r"""
     (?P<email>[\w.+-]+@[\w-]+(?:\.[\w-]+)+)
   | (?P<url>(?:https?://|www\.)\S*[^\s.,;:!?)"'])
-  | (?P<money>[$£€]\d[\d,]*(?:\.\d+)?)
+  | (?P<money>[$£€]\d+(?:,\d{3})*(?:\.\d+)?)
   | (?P<time>\d{1,2}:\d{2}(?:\s?[ap]\.?m\b\.?)?)
   | (?P<decade>\d{3}0s\b|'\d0s\b)
   | (?P<ordinal>\d+(?:st|nd|rd|th)\b)
-  | (?P<number>-?\d[\d,]*(?:\.\d+)?%?)
+  | (?P<number>-?\d+(?:,\d{3})*(?:\.\d+)?%?)
   | (?P<word>[^\W\d_](?:[^\W\d_]|['’](?=[^\W\d_]))*(?:\.(?!\.))?(?:[^\W\d_]\.(?!\.))*)
   | (?P<dash>\s-\s|--+|[—–])
   | (?P<ellipsis>\.\.\.+|…)
