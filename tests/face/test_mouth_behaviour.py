@@ -171,3 +171,14 @@ def test_phone_map_with_unknown_viseme_fails_with_file_line(tmp_path) -> None:
     with pytest.raises(TableError) as e:
         load_phone_map(p, shapes())
     assert f"{p}:2" in str(e.value)
+
+
+def test_no_model_exceeds_the_documented_node_speed_limit() -> None:
+    from lipclock.face.models import MAX_NODE_SPEED_MM_S
+    from lipclock.speech.frontend import text_to_timeline
+
+    tl = text_to_timeline("Pop the big map, mom; we buy five bobbing apples.", rate_wpm=450)
+    for name in MOUTH_MODELS:
+        track = mouth_for(tl, name, rate_hz=100.0)
+        step = np.linalg.norm(np.diff(track.frames, axis=0), axis=2)
+        assert step.max() * 100.0 <= MAX_NODE_SPEED_MM_S * 1.001, name

@@ -14,6 +14,7 @@ import math
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from ..errors import OutOfRangeError, UnknownChoiceError
 from ..speech.timeline import Timeline
@@ -54,7 +55,29 @@ def measures_from_nodes(nodes: np.ndarray) -> dict[str, np.ndarray]:
             "width": width.astype(np.float32), "jaw": jaw.astype(np.float32)}
 
 
+MAX_NODE_SPEED_MM_S = 500.0  # lips at face scale: 0.5 m/s (docs/mouth.md)
+
+
+@njit(cache=True, nogil=True)
+def limit_node_speed(nodes: np.ndarray, max_step_mm: float) -> np.ndarray:
+    """No node moves more than ``max_step_mm`` between frames: it follows late instead."""
+    out = nodes.copy()
+    for k in range(1, out.shape[0]):
+        for i in range(out.shape[1]):
+            dx = out[k, i, 0] - out[k - 1, i, 0]
+            dy = out[k, i, 1] - out[k - 1, i, 1]
+            d = math.sqrt(dx * dx + dy * dy)
+            if d > max_step_mm:
+                f = max_step_mm / d
+                out[k, i, 0] = out[k - 1, i, 0] + dx * f
+                out[k, i, 1] = out[k - 1, i, 1] + dy * f
+    return out
+
+
 def _track(timeline: Timeline, rate_hz: float, model: str, nodes: np.ndarray) -> MouthTrack:
+    # the documented physiological limit holds for every model (spring and bigram already
+    # stay under it; the interpolation baselines can exceed it in fast speech)
+    nodes = limit_node_speed(nodes.astype(np.float64), MAX_NODE_SPEED_MM_S / rate_hz)
     nodes = nodes.astype(np.float32)
     return MouthTrack(timeline.sample_rate, rate_hz, model, NODES, nodes,
                       measures_from_nodes(nodes))
