@@ -22,25 +22,9 @@ from ..tables import package_file
 from .shape import LOWER_LIP_MID, NODES, UPPER_LIP_MID, nodes_from_measures
 from .spring import default_dynamics, load_dynamics, spring_nodes
 from .track import MouthTrack
-from .visemes import shapes, viseme_of
+from .visemes import viseme_nodes, viseme_of
 
 MOUTH_MODELS = ("linear", "cosine", "spring", "bigram")
-
-def _targets(timeline: Timeline) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """Per phone: centre sample, target measures (n, 4), viseme names."""
-    sh = shapes()
-    centres, vecs, names = [], [], []
-    for p in timeline.phones:
-        v = viseme_of(p.phone)
-        vec = list(sh[v].vector())
-        if p.phone == "AH0":
-            vec[0] *= 0.6  # schwa: smaller opening
-            vec[3] *= 0.6
-        centres.append((p.start + p.end) // 2)
-        vecs.append(vec)
-        names.append(v)
-    return np.array(centres, dtype=np.float64), np.array(vecs, dtype=np.float64), names
-
 
 CHIN = NODES.index("chin")
 CHIN_ZERO_Y = -32.0  # chin y with the jaw at 0 mm (face/shape.py)
@@ -88,8 +72,20 @@ def _frame_samples(timeline: Timeline, rate_hz: float) -> np.ndarray:
     return np.round(np.arange(n) * (timeline.sample_rate / rate_hz))
 
 
+def _node_targets(timeline: Timeline) -> tuple[np.ndarray, np.ndarray]:
+    """Per phone: centre sample and its viseme's node positions (viseme_nodes.tsv)."""
+    table = viseme_nodes()
+    rest = table["rest"]
+    centres = np.array([(p.start + p.end) // 2 for p in timeline.phones], dtype=np.float64)
+    nodes = np.stack([table[viseme_of(p.phone)] for p in timeline.phones])
+    schwa = np.array([p.phone == "AH0" for p in timeline.phones])
+    nodes[schwa] = rest + 0.6 * (nodes[schwa] - rest)  # schwa: a smaller opening
+    return centres, nodes
+
+
 def _interp(timeline: Timeline, rate_hz: float, cosine: bool) -> np.ndarray:
-    centres, vecs, _ = _targets(timeline)
+    """Node positions interpolated between viseme targets at phone centres (DECface)."""
+    centres, vecs = _node_targets(timeline)
     fs = _frame_samples(timeline, rate_hz)
     idx = np.clip(np.searchsorted(centres, fs, side="right") - 1, 0, len(centres) - 1)
     nxt = np.minimum(idx + 1, len(centres) - 1)
@@ -97,7 +93,7 @@ def _interp(timeline: Timeline, rate_hz: float, cosine: bool) -> np.ndarray:
     u = np.clip((fs - centres[idx]) / span, 0.0, 1.0)
     if cosine:
         u = 0.5 - 0.5 * np.cos(np.pi * u)
-    return vecs[idx] + (vecs[nxt] - vecs[idx]) * u[:, None]
+    return vecs[idx] + (vecs[nxt] - vecs[idx]) * u[:, None, None]
 
 
 def mouth_for(timeline: Timeline, model: str = "spring", rate_hz: float = 100.0,
@@ -116,7 +112,5 @@ def mouth_for(timeline: Timeline, model: str = "spring", rate_hz: float = 100.0,
         nodes = nodes_from_measures(bigram_measures(
             timeline, _frame_samples(timeline, rate_hz), params))
     else:
-        m = _interp(timeline, rate_hz, cosine=(model == "cosine"))
-        m[:, 0] = np.maximum(m[:, 0], 0.0)
-        nodes = nodes_from_measures(m)
+        nodes = _interp(timeline, rate_hz, cosine=(model == "cosine"))
     return _track(timeline, rate_hz, model, nodes)

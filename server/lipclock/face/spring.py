@@ -27,27 +27,17 @@ from numba import njit
 from ..errors import OutOfRangeError, TableError, UnknownChoiceError
 from ..speech.timeline import Timeline
 from ..tables import finite_float, line_of, load_toml, package_file
-from .shape import NODES, nodes_from_measures
-from .visemes import shapes, viseme_of
+from .shape import NODES
+from .topology import topology
+from .visemes import shapes, viseme_nodes, viseme_of
 
 _LIP_PAIRS = [(NODES.index(f"inner_upper_{i}"), NODES.index(f"inner_lower_{i}"))
               for i in range(5)]
 LIP_NODES = [i for i, n in enumerate(NODES) if n.startswith(("inner_", "outer_"))]
+_INNER_UPPER = [NODES.index(f"inner_upper_{i}") for i in range(5)]
+_INNER_LOWER = [NODES.index(f"inner_lower_{i}") for i in range(5)]
 
 
-def _edges() -> np.ndarray:
-    e: list[tuple[str, str]] = []
-    for part in ("outer_upper", "outer_lower", "inner_upper", "inner_lower"):
-        chain = ["corner_l", *(f"{part}_{i}" for i in range(5)), "corner_r"]
-        e += list(zip(chain, chain[1:], strict=False))
-    for side in ("upper", "lower"):
-        e += [(f"inner_{side}_{i}", f"outer_{side}_{i}") for i in range(5)]
-    e += [("teeth_lower_l", "teeth_lower_c"), ("teeth_lower_c", "teeth_lower_r"),
-          ("teeth_lower_c", "chin")]
-    return np.array([(NODES.index(a), NODES.index(b)) for a, b in e], dtype=np.int64)
-
-
-EDGES = _edges()
 
 
 @dataclass(frozen=True)
@@ -138,7 +128,7 @@ def default_dynamics() -> Dynamics:
 
 def check_stability(d: Dynamics, dt: float) -> None:
     """Reject parameters whose stiffest node would make semi-implicit Euler unstable."""
-    degree = np.bincount(EDGES.ravel(), minlength=len(NODES))
+    degree = np.bincount(topology().edges.ravel(), minlength=len(NODES))
     k_eff = d.stiffness + degree * d.neighbour_stiffness
     k_eff[LIP_NODES] = np.maximum(k_eff[LIP_NODES], d.closure_stiffness
                                   + degree[LIP_NODES] * d.neighbour_stiffness)
@@ -156,11 +146,13 @@ def spring_nodes(timeline: Timeline, rate_hz: float, d: Dynamics) -> np.ndarray:
     dt = step / sr
     check_stability(d, dt)
     names = sorted(shapes())
-    vec = np.array([shapes()[n].vector() for n in names])
+    table = viseme_nodes()
+    targets = np.stack([table[n] for n in names]).astype(np.float64)
     closure = np.array([n in d.closure_visemes for n in names])
-    vec[closure, 0] = -d.overshoot_mm  # aim past contact
-    targets = nodes_from_measures(vec).astype(np.float64)
-    rest = nodes_from_measures(np.array([shapes()["rest"].vector()]))[0].astype(np.float64)
+    for v in np.flatnonzero(closure):  # aim past contact: the lips press together
+        targets[v, _INNER_UPPER, 1] = targets[v, _INNER_UPPER, 1].mean() - 0.35 * d.overshoot_mm
+        targets[v, _INNER_LOWER, 1] = targets[v, _INNER_UPPER, 1] + d.overshoot_mm
+    rest = table["rest"].astype(np.float64)
     lead = round(d.anticipation_s * sr)
     n_steps = timeline.num_samples // step + 2
     starts = np.array([p.start for p in timeline.phones]) - lead
@@ -172,7 +164,7 @@ def spring_nodes(timeline: Timeline, rate_hz: float, d: Dynamics) -> np.ndarray:
     n_frames = int(math.floor(timeline.num_samples * rate_hz / sr)) + 1
     frame_pos = np.round(np.arange(n_frames) * (sr / rate_hz)) / step  # in steps
     return _integrate(vis_idx, targets, closure, rest, d.mass, d.stiffness, d.damping,
-                      d.closure_stiffness, d.closure_damping, lips, EDGES,
+                      d.closure_stiffness, d.closure_damping, lips, topology().edges,
                       d.neighbour_stiffness, np.array(_LIP_PAIRS, dtype=np.int64), dt,
                       frame_pos)
 
@@ -181,47 +173,63 @@ def spring_nodes(timeline: Timeline, rate_hz: float, d: Dynamics) -> np.ndarray:
 def _integrate(vis_idx, targets, closure, rest, mass, k, c, k_cl, c_cl, lips, edges, k_nb,
                lip_pairs, dt, frame_pos):  # type: ignore[no-untyped-def]
     """Step the mesh; record node positions at the first step at or after each frame
-    (``frame_pos`` in steps; at most half a step, 1 ms, from the frame's sample)."""
+    (``frame_pos`` in steps; at most half a step, 1 ms, from the frame's sample).
+
+    Arrays are flattened to x0, y0, x1, y1, ... so the per-node loops are simple."""
     n_steps = vis_idx.shape[0]
     n = rest.shape[0]
+    m2 = 2 * n
+    flat_t = targets.reshape(targets.shape[0], m2)
+    x = rest.reshape(m2).copy()
+    v = np.zeros(m2)
+    f = np.empty(m2)
+    inv_m = np.empty(m2)
+    k_open, c_open = np.empty(m2), np.empty(m2)
+    k_close, c_close = np.empty(m2), np.empty(m2)
+    for i in range(n):
+        for a in range(2):
+            j = 2 * i + a
+            inv_m[j] = dt / mass[i]
+            k_open[j], c_open[j] = k[i], c[i]
+            k_close[j] = k_cl if lips[i] else k[i]
+            c_close[j] = c_cl if lips[i] else c[i]
     out = np.empty((frame_pos.shape[0], n, 2))
     fi = 0
-    x = rest.copy()
-    v = np.zeros((n, 2))
-    f = np.zeros((n, 2))
+    n_e = edges.shape[0]
     for s in range(n_steps):
         vi = vis_idx[s]
-        tgt = targets[vi]
-        cl = closure[vi]
-        for i in range(n):
-            ki, ci = k[i], c[i]
-            if cl and lips[i]:
-                ki, ci = k_cl, c_cl
+        if closure[vi]:
+            ks, cs = k_close, c_close
+        else:
+            ks, cs = k_open, c_open
+        for j in range(m2):
+            f[j] = ks[j] * (flat_t[vi, j] - x[j]) - cs[j] * v[j]
+        for e in range(n_e):
+            i2, j2 = 2 * edges[e, 0], 2 * edges[e, 1]
             for a in range(2):
-                f[i, a] = ki * (tgt[i, a] - x[i, a]) - ci * v[i, a]
-        for e in range(edges.shape[0]):
-            i, j = edges[e, 0], edges[e, 1]
-            for a in range(2):
-                stretch = (x[j, a] - x[i, a]) - (tgt[j, a] - tgt[i, a])
-                f[i, a] += k_nb * stretch
-                f[j, a] -= k_nb * stretch
-        for i in range(n):
-            for a in range(2):
-                v[i, a] += f[i, a] / mass[i] * dt
-                x[i, a] += v[i, a] * dt
+                stretch = (x[j2 + a] - x[i2 + a]) - (flat_t[vi, j2 + a] - flat_t[vi, i2 + a])
+                f[i2 + a] += k_nb * stretch
+                f[j2 + a] -= k_nb * stretch
+        for j in range(m2):
+            v[j] += f[j] * inv_m[j]
+            x[j] += v[j] * dt
         for p in range(lip_pairs.shape[0]):  # the inner lips touch; they never cross
-            u, lo = lip_pairs[p, 0], lip_pairs[p, 1]
-            if x[lo, 1] > x[u, 1]:
-                mid = 0.5 * (x[lo, 1] + x[u, 1])
-                x[lo, 1] = mid
-                x[u, 1] = mid
-                vm = 0.5 * (v[lo, 1] + v[u, 1])
-                v[lo, 1] = vm
-                v[u, 1] = vm
+            u, lo = 2 * lip_pairs[p, 0] + 1, 2 * lip_pairs[p, 1] + 1
+            if x[lo] > x[u]:
+                mid = 0.5 * (x[lo] + x[u])
+                x[lo] = mid
+                x[u] = mid
+                vm = 0.5 * (v[lo] + v[u])
+                v[lo] = vm
+                v[u] = vm
         while fi < frame_pos.shape[0] and frame_pos[fi] <= s + 0.5:
-            out[fi] = x
+            for i in range(n):
+                out[fi, i, 0] = x[2 * i]
+                out[fi, i, 1] = x[2 * i + 1]
             fi += 1
     while fi < frame_pos.shape[0]:  # frames past the last step hold the final pose
-        out[fi] = x
+        for i in range(n):
+            out[fi, i, 0] = x[2 * i]
+            out[fi, i, 1] = x[2 * i + 1]
         fi += 1
     return out

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import TableError
 from ..speech.phoneset import phones
 from ..speech.timeline import Timeline
@@ -78,6 +80,45 @@ def shapes() -> dict[str, VisemeShape]:
 @cache
 def phone_map() -> dict[str, str]:
     return load_phone_map(package_file("lipclock.viseme_tables", "phone_visemes.tsv"), shapes())
+
+
+def load_viseme_nodes(path: Path, known: dict[str, VisemeShape]) -> dict[str, np.ndarray]:
+    """``viseme node x y`` rows -> {viseme: (N_NODES, 2)}; every viseme gives every node."""
+    from .shape import NODES
+
+    index = {n: i for i, n in enumerate(NODES)}
+    out: dict[str, np.ndarray] = {}
+    seen: dict[str, set[str]] = {}
+    first_line: dict[str, int] = {}
+    for line, f in iter_tsv(path):
+        if len(f) != 4:
+            raise TableError(path, line, f"expected 4 columns, got {len(f)}")
+        vis, node = f[0], f[1]
+        if vis not in known:
+            raise TableError(path, line, f"unknown viseme {vis!r}")
+        if node not in index:
+            raise TableError(path, line, f"unknown node {node!r}")
+        if node in seen.setdefault(vis, set()):
+            raise TableError(path, line, f"{vis}: node {node!r} given twice")
+        x = finite_float(path, line, "x_mm", f[2])
+        y = finite_float(path, line, "y_mm", f[3])
+        arr = out.setdefault(vis, np.zeros((len(NODES), 2)))
+        first_line.setdefault(vis, line)
+        arr[index[node]] = (x, y)
+        seen[vis].add(node)
+    for vis in known:
+        if vis not in out:
+            raise TableError(path, 1, f"viseme {vis!r} has no node positions")
+        missing = [n for n in NODES if n not in seen[vis]]
+        if missing:
+            raise TableError(path, first_line[vis], f"{vis}: missing nodes {', '.join(missing)}")
+    return out
+
+
+@cache
+def viseme_nodes() -> dict[str, np.ndarray]:
+    return load_viseme_nodes(package_file("lipclock.viseme_tables", "viseme_nodes.tsv"),
+                             shapes())
 
 
 def viseme_of(phone: str) -> str:
