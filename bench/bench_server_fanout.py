@@ -1,13 +1,15 @@
 """Fan-out bench (issue 5): N subscribers on one channel receive continuous speech without underrun.
 
-Starts a real server (`lipclock serve`) on loopback, connects N WebSocket
-clients (default 200) to one channel from this separate client process, then
-POSTs several sentences back to back. A client "underruns" if the audio frame
-starting at sample s arrives later than s / sample_rate seconds after that
-client's first audio frame (plus --buffer-ms of playout buffer, as a browser
-would keep). Prints clients without underrun beside the goal (all N).
+Starts a real server (`lipclock serve`) on loopback and connects N WebSocket clients
+(default 200) to one channel from --procs separate client processes (so the bench's own
+JSON decoding does not become the bottleneck), then POSTs several sentences back to back.
+A client "underruns" if audio for second N of an utterance arrives after playback
+reaches second N: a frame starting at sample s is due floor(s / sample_rate) seconds
+after that client's first audio frame of the utterance, plus --buffer-ms of playout
+buffer (as a browser would keep). Prints clients without
+underrun beside the goal (all N).
 
-    .venv/bin/python bench/bench_server_fanout.py --clients 200
+    .venv/bin/python bench/bench_server_fanout.py --clients 200 [--procs 4]
 """
 
 from __future__ import annotations
@@ -15,17 +17,16 @@ from __future__ import annotations
 import argparse
 import asyncio
 import json
-import os
+import multiprocessing as mp
 import struct
-import subprocess
-import sys
 import time
-
-import socket
 
 import httpx
 import websockets
 
+from serverutil import running_server
+
+HEADER = struct.Struct("<4sIQ")
 SENTENCES = [
     "The quick brown fox jumped over the lazy dog while the farmer watched from "
     "behind the old red barn door.",
@@ -36,96 +37,79 @@ SENTENCES = [
 ]
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
-async def wait_up(base: str, proc: subprocess.Popen[bytes]) -> None:
-    async with httpx.AsyncClient() as c:
-        for _ in range(300):
-            if proc.poll() is not None:
-                raise SystemExit("server exited during start")
-            try:
-                if (await c.get(base + "/healthz")).status_code == 200:
-                    return
-            except httpx.HTTPError:
-                pass
-            await asyncio.sleep(0.1)
-    raise SystemExit("server did not come up")
-
-HEADER = struct.Struct("<4sIQ")
-
-
-async def client(url: str, ready: asyncio.Event, done: asyncio.Event, n_utt: int,
-                 sample_rate_box: list[int], buffer_s: float) -> tuple[float, int]:
+async def client(url: str, ready: asyncio.Event, n_utt: int, buffer_s: float
+                 ) -> tuple[float, int]:
     """Return (worst lateness in s, audio frames received)."""
-    async with websockets.connect(url, max_size=None) as ws:
-        hello = json.loads(await ws.recv())
-        sample_rate_box[0] = int(hello["sample_rate"])
+    async with websockets.connect(url, max_size=None, compression=None) as ws:
+        sample_rate = int(json.loads(await ws.recv())["sample_rate"])
         ready.set()
-        worst = -1e9
-        frames = 0
-        ends = 0
-        origin: tuple[float, int, int] | None = None  # (arrival, utt id, first sample)
-        play_offset_s = 0.0
+        worst, frames, ends = -1e9, 0, 0
+        origin: float | None = None
         while ends < n_utt:
             msg = await ws.recv()
             now = time.perf_counter()
             if isinstance(msg, bytes):
-                _, uid, first = HEADER.unpack_from(msg)
+                _, _, first = HEADER.unpack_from(msg)
                 frames += 1
                 if origin is None:
-                    origin = (now, uid, first)
-                    play_offset_s = 0.0
-                due = origin[0] + buffer_s + play_offset_s + first / sample_rate_box[0]
-                worst = max(worst, now - due)
-            elif json.loads(msg).get("type") == "end":
+                    origin = now
+                # the issue's rule: data for second N must arrive before playback
+                # reaches second N (stricter than the chunk's own start time)
+                second = first // sample_rate
+                worst = max(worst, now - (origin + buffer_s + second))
+            elif msg.startswith('{"type":"end"'):  # delivery is measured, not parsing
                 ends += 1
                 origin = None
         return worst, frames
 
 
-async def main_async(args: argparse.Namespace) -> int:
-    port = free_port()
-    base = f"http://127.0.0.1:{port}"
-    proc = subprocess.Popen([os.path.join(os.path.dirname(sys.executable), "lipclock"), "serve",
-                             "--host", "127.0.0.1", "--port", str(port)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        await wait_up(base, proc)
-        url = f"ws://127.0.0.1:{port}/ws?channel=fan"
-        sr = [0]
-        readies = [asyncio.Event() for _ in range(args.clients)]
-        done = asyncio.Event()
-        tasks = [asyncio.create_task(client(url, r, done, args.utterances, sr, args.buffer_ms / 1000))
-                 for r in readies]
+def worker(url: str, n: int, n_utt: int, buffer_s: float, ready_q: mp.Queue,
+           out_q: mp.Queue) -> None:
+    async def run() -> list[tuple[float, int]]:
+        readies = [asyncio.Event() for _ in range(n)]
+        tasks = [asyncio.create_task(client(url, r, n_utt, buffer_s)) for r in readies]
         await asyncio.gather(*(r.wait() for r in readies))
-        async with httpx.AsyncClient(timeout=60) as http:
-            for i in range(args.utterances):
-                (await http.post(base + "/speak", json={"text": SENTENCES[i % len(SENTENCES)],
-                                                        "channel": "fan"})).raise_for_status()
-        results = await asyncio.wait_for(asyncio.gather(*tasks), timeout=300)
-        ok = sum(1 for worst, _ in results if worst <= 0)
-        worst_ms = max(w for w, _ in results) * 1000
-        frames = sorted(f for _, f in results)
-        print(f"clients={args.clients} utterances={args.utterances} buffer={args.buffer_ms} ms")
-        print(f"clients without underrun: {ok}/{args.clients} (goal all); worst lateness "
-              f"{worst_ms:.1f} ms; audio frames per client min {frames[0]} median "
-              f"{frames[len(frames) // 2]} max {frames[-1]}")
-    finally:
-        proc.terminate()
-        proc.wait(timeout=10)
-    return 0
+        ready_q.put(n)
+        return await asyncio.wait_for(asyncio.gather(*tasks), timeout=300)
+
+    out_q.put(asyncio.run(run()))
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__)
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--clients", type=int, default=200)
+    ap.add_argument("--procs", type=int, default=4, help="client processes")
     ap.add_argument("--utterances", type=int, default=3)
-    ap.add_argument("--buffer-ms", type=float, default=100.0)
-    return asyncio.run(main_async(ap.parse_args()))
+    ap.add_argument("--buffer-ms", type=float, default=120.0,
+                    help="playout buffer; 120 ms is client/lipclock.js jitterBufferS")
+    args = ap.parse_args()
+    ctx = mp.get_context("spawn")
+    with running_server() as (addr, _):
+        url = f"ws://{addr}/ws?channel=fan"
+        ready_q, out_q = ctx.Queue(), ctx.Queue()
+        shares = [args.clients // args.procs + (i < args.clients % args.procs)
+                  for i in range(args.procs)]
+        procs = [ctx.Process(target=worker, args=(url, n, args.utterances,
+                                                  args.buffer_ms / 1000, ready_q, out_q))
+                 for n in shares if n]
+        for p in procs:
+            p.start()
+        connected = sum(ready_q.get(timeout=120) for _ in procs)
+        with httpx.Client(base_url=f"http://{addr}", timeout=60) as http:
+            for i in range(args.utterances):
+                http.post("/speak", json={"text": SENTENCES[i % len(SENTENCES)],
+                                          "channel": "fan"}).raise_for_status()
+        results = [r for _ in procs for r in out_q.get(timeout=300)]
+        for p in procs:
+            p.join(timeout=30)
+    ok = sum(1 for worst, _ in results if worst <= 0)
+    frames = sorted(f for _, f in results)
+    print(f"clients={connected} in {len(procs)} processes, utterances={args.utterances}, "
+          f"playout buffer {args.buffer_ms:.0f} ms")
+    print(f"clients without underrun: {ok}/{connected} (goal: all); worst lateness "
+          f"{max(w for w, _ in results) * 1000:.1f} ms; audio frames per client "
+          f"min {frames[0]} median {frames[len(frames) // 2]} max {frames[-1]}")
+    return 0
 
 
 if __name__ == "__main__":
