@@ -62,13 +62,14 @@ def test_chunks_concatenate_to_the_whole(utt):
     assert np.array_equal(joined, utt.samples)
 
 
-def test_chunk_bounds_small_first_chunk_then_capped():
+def test_chunk_bounds_small_first_chunk_then_first_second_then_capped():
     prep = lipclock.prepare("This is a fairly long sentence without any commas in it at all "
                             "so the chunker has to split it inside the phrase.")
-    bounds = chunk_bounds(prep.timeline, first_chunk_s=0.05, max_chunk_s=0.4)
-    assert bounds[0] == 800
+    bounds = chunk_bounds(prep.timeline, first_chunk_s=0.05, max_chunk_s=0.4,
+                          first_second_s=1.0)
+    assert bounds[:2] == [800, 16000]  # a small first chunk, then the rest of second 0
     assert bounds[-1] == prep.timeline.num_samples
-    assert all(b - a <= 6400 for a, b in zip(bounds, bounds[1:], strict=False))
+    assert all(b - a <= 6400 for a, b in zip(bounds[1:], bounds[2:], strict=False))
 
 
 def test_voices_rate_and_pitch_change_output():

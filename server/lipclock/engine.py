@@ -31,7 +31,8 @@ from .speech.tokens import Pronounced, Token
 from .speech.voices import Voice, get_voice
 
 SUPPORTED_SAMPLE_RATES = (8000, 16000, 22050, 24000, 48000)
-FIRST_CHUNK_S = 0.05  # small first chunk: playback can start after ~1 ms of work
+FIRST_CHUNK_S = 0.25  # small first chunk: playback starts after ~1 ms of work
+FIRST_SECOND_S = 1.0  # the second chunk completes the first second of audio
 MAX_CHUNK_S = 0.4  # later chunks end at phrase boundaries or after this much audio
 
 
@@ -202,13 +203,18 @@ def _lexicon_for(s: Settings) -> Lexicon:
 
 
 def chunk_bounds(timeline: Timeline, first_chunk_s: float = FIRST_CHUNK_S,
-                 max_chunk_s: float = MAX_CHUNK_S) -> list[int]:
-    """End samples of the audio chunks: a small first chunk, then phrase ends, capped in size."""
+                 max_chunk_s: float = MAX_CHUNK_S,
+                 first_second_s: float = FIRST_SECOND_S) -> list[int]:
+    """End samples of the audio chunks: a small first chunk, then the rest of the first
+    second (so a player has all of second 0 at once), then phrase ends, capped in size."""
     sr = timeline.sample_rate
     total = timeline.num_samples
     breaks = sorted({p.end for p in timeline.phrases} | {total})
     first = min(total, max(1, round(first_chunk_s * sr)))
     bounds = [first]
+    second = min(total, round(first_second_s * sr))
+    if second > first:
+        bounds.append(second)
     cap = max(1, round(max_chunk_s * sr))
     for b in breaks:
         while b - bounds[-1] > cap:

@@ -107,21 +107,28 @@ class Channel:
         mouth = prep.mouth
         sent_frames = 0
         end_sample = 0
+        take = 2  # the first thread hop renders the first two chunks (all of second 0)
         while not job.stop.is_set():
-            chunk = await asyncio.to_thread(next, chunks, None)
-            if chunk is None or job.stop.is_set():
+            batch = await asyncio.to_thread(_take, chunks, take)
+            take = 1
+            if not batch or job.stop.is_set():
                 break
-            lo, hi = mouth.frame_range(0, chunk.end_sample)
-            if hi > sent_frames:
-                self.broadcast(mouth_message(job.utterance_id, prep, sent_frames, hi)
-                               .model_dump_json())
-                sent_frames = hi
-            self.broadcast(pack_audio(job.utterance_id, chunk.start_sample,
-                                      chunk.samples.astype("<i2").tobytes()))
-            end_sample = chunk.end_sample
+            for chunk in batch:
+                lo, hi = mouth.frame_range(0, chunk.end_sample)
+                if hi > sent_frames:
+                    self.broadcast(mouth_message(job.utterance_id, prep, sent_frames, hi)
+                                   .model_dump_json())
+                    sent_frames = hi
+                self.broadcast(pack_audio(job.utterance_id, chunk.start_sample,
+                                          chunk.samples.astype("<i2").tobytes()))
+                end_sample = chunk.end_sample
         stopped = job.stop.is_set() and end_sample < prep.num_samples
         self.broadcast(End(utterance_id=job.utterance_id, end_sample=end_sample,
                            stopped=stopped).model_dump_json())
+
+
+def _take(chunks: Any, n: int) -> list[Any]:
+    return [c for c in itertools.islice(chunks, n)]
 
 
 def start_message(uid: int, prep: Prepared) -> Start:
