@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from fastapi import FastAPI, Header, Request, WebSocket
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, PlainTextResponse, Response
 from pydantic import BaseModel, Field, ValidationError
 from starlette.websockets import WebSocketDisconnect
@@ -97,6 +98,16 @@ def create_app(settings: Settings | None = None) -> FastAPI:
                                        pitch_hz=pitch, mouth_model=model, settings=s)
         metrics.observe_prepare(time.perf_counter() - t0, prep.duration_s)
         return prep
+
+    @app.exception_handler(RequestValidationError)
+    async def _invalid(_: Request, exc: RequestValidationError) -> JSONResponse:
+        # FastAPI's default handler echoes the input, and crashes on NaN/Infinity in it
+        errors = [{"loc": [str(x) for x in e.get("loc", ())], "msg": str(e.get("msg", "")),
+                   "type": str(e.get("type", ""))} for e in exc.errors()]
+        reason = "; ".join(f"{'.'.join(e['loc'])}: {e['msg']}" for e in errors[:3])
+        metrics.error("bad_request")
+        return JSONResponse({"error": {"code": "bad_request", "reason": reason},
+                             "detail": errors}, status_code=422)
 
     @app.exception_handler(LipclockError)
     async def _lipclock_error(_: Request, exc: LipclockError) -> JSONResponse:
@@ -296,11 +307,12 @@ async def serve_socket(websocket: WebSocket, s: Settings, broker: Broker, store:
     except WebSocketDisconnect:
         pass
     finally:
+        # bookkeeping first: if this task is being cancelled, the await below is cut short
         channel.subscribers.discard(sub)
-        sender.cancel()
-        await asyncio.gather(sender, return_exceptions=True)
         metrics.connections -= 1
+        sender.cancel()
         broker.drop_if_idle(name)
+        await asyncio.gather(sender, return_exceptions=True)
 
 
 async def _send_loop(websocket: WebSocket, sub: Subscriber) -> None:
