@@ -5,6 +5,8 @@ Precedence: explicit CLI flags > environment > defaults embedded here.
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
@@ -35,6 +37,11 @@ class Settings(BaseSettings):
     max_client_queue: int = Field(1024, ge=8, description="Messages buffered per client")
     max_queued_utterances: int = Field(8, ge=1, description="Utterances waiting per channel")
     utterance_store: int = Field(64, ge=1, description="Recent utterances kept for download")
+    clock: Literal["client", "device"] = Field(
+        "client", description="client: each browser plays the audio; device: this server "
+        "plays it and broadcasts the device clock (kiosk)")
+    audio_device: str = Field("auto", description="device mode output: auto (PortAudio if "
+                              "present, else simulated), simulated, or a PortAudio device")
 
     @property
     def auth_enabled(self) -> bool:

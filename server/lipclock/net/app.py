@@ -8,10 +8,12 @@ Synthesis runs in worker threads so the event loop stays responsive.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import logging
 import re
 import time
+from collections.abc import AsyncIterator
 from pathlib import Path
 from typing import Any
 
@@ -39,10 +41,12 @@ from .channels import (
     next_utterance_id,
     summary,
 )
+from .clock import open_device
 from .metrics import Metrics
 from .protocol import (
     CLIENT_MESSAGE,
     CLIENT_TYPES,
+    Clock,
     Error,
     Hello,
     Ping,
@@ -74,9 +78,23 @@ def _error(status: int, code: str, reason: str) -> JSONResponse:
 
 def create_app(settings: Settings | None = None) -> FastAPI:
     s = settings or Settings()
-    app = FastAPI(title="lipclock", version=lipclock.__version__,
+    device = open_device(s.sample_rate, s.audio_device) if s.clock == "device" else None
+
+    @contextlib.asynccontextmanager
+    async def lifespan(_: FastAPI) -> AsyncIterator[None]:
+        ticker = asyncio.create_task(_clock_ticker(broker)) if device is not None else None
+        try:
+            yield
+        finally:
+            if ticker is not None:
+                ticker.cancel()
+                await asyncio.gather(ticker, return_exceptions=True)
+            if device is not None:
+                device.close()
+
+    app = FastAPI(title="lipclock", version=lipclock.__version__, lifespan=lifespan,
                   description="Text-to-speech with a talking face, stamped on the audio clock.")
-    broker = Broker(s.max_queued_utterances)
+    broker = Broker(s.max_queued_utterances, device)
     store = UtteranceStore(s.utterance_store)
     metrics = Metrics()
     app.state.broker, app.state.store, app.state.metrics = broker, store, metrics
@@ -247,7 +265,9 @@ async def serve_socket(websocket: WebSocket, s: Settings, broker: Broker, store:
         except ChannelBusy as exc:
             fail("channel_busy", str(exc))
 
-    reply(Hello(sample_rate=s.sample_rate, channel=name))
+    reply(Hello(sample_rate=s.sample_rate, channel=name, clock=s.clock))
+    if broker.device is not None:
+        reply(_clock_message(broker))
     try:
         while not sender.done():
             msg = await websocket.receive()
@@ -313,6 +333,23 @@ async def serve_socket(websocket: WebSocket, s: Settings, broker: Broker, store:
         sender.cancel()
         broker.drop_if_idle(name)
         await asyncio.gather(sender, return_exceptions=True)
+
+
+CLOCK_PERIOD_S = 0.1
+
+
+def _clock_message(broker: Broker) -> Clock:
+    assert broker.device is not None
+    sample, at = broker.device.position()
+    return Clock(device_sample=sample, server_time_s=at)
+
+
+async def _clock_ticker(broker: Broker) -> None:
+    """Device mode: tell every subscriber the device clock ten times a second."""
+    while True:
+        await asyncio.sleep(CLOCK_PERIOD_S)
+        if any(ch.subscribers for ch in broker.channels.values()):
+            broker.broadcast_all(_clock_message(broker).model_dump_json())
 
 
 async def _send_loop(websocket: WebSocket, sub: Subscriber) -> None:

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..utterance import Prepared
+from .clock import Device
 from .protocol import End, Mouth, Start, pack_audio
 
 log = logging.getLogger("lipclock.channels")
@@ -57,15 +58,19 @@ class Job:
     utterance_id: int
     prepared: Prepared
     stop: asyncio.Event = field(default_factory=asyncio.Event)
+    device_start: int | None = None
+    device_stopped_at: int | None = None
 
 
 class Channel:
-    def __init__(self, name: str, max_queued: int) -> None:
+    def __init__(self, name: str, max_queued: int, device: Device | None = None) -> None:
         self.name = name
+        self.device = device  # device mode: audio plays here too
         self.subscribers: set[Subscriber] = set()
         self.pending: asyncio.Queue[Job] = asyncio.Queue(maxsize=max_queued)
         self.current: Job | None = None
         self.worker: asyncio.Task[None] | None = None
+        self.on_device: list[Job] = []  # device mode: streamed, maybe still playing
 
     def broadcast(self, item: str | bytes) -> None:
         for sub in list(self.subscribers):
@@ -84,8 +89,21 @@ class Channel:
         """Barge-in: cut the current utterance and drop the queued ones."""
         while not self.pending.empty():
             self.pending.get_nowait()
+        at = self.device.stop() if self.device is not None else None
         if self.current is not None:
             self.current.stop.set()
+            self.current.device_stopped_at = at
+        if at is not None:
+            # device mode: utterances already streamed may still be playing or queued on
+            # the device; tell every display where each was cut
+            for job in self.on_device:
+                if job is self.current or job.device_start is None:
+                    continue
+                if at < job.device_start + job.prepared.num_samples:
+                    cut = max(0, at - job.device_start)
+                    self.broadcast(End(utterance_id=job.utterance_id, end_sample=cut,
+                                       stopped=True).model_dump_json())
+            self.on_device.clear()
 
     async def _run(self) -> None:
         while not self.pending.empty():
@@ -102,17 +120,26 @@ class Channel:
 
     async def _play(self, job: Job) -> None:
         prep = job.prepared
-        self.broadcast(start_message(job.utterance_id, prep).model_dump_json())
         chunks = prep.audio_chunks()
         mouth = prep.mouth
         sent_frames = 0
         end_sample = 0
         take = 2  # the first thread hop renders the first two chunks (all of second 0)
+        started = False
         while not job.stop.is_set():
             batch = await asyncio.to_thread(_take, chunks, take)
             take = 1
             if not batch or job.stop.is_set():
                 break
+            if self.device is not None:
+                for chunk in batch:
+                    first = self.device.enqueue(chunk.samples)
+                    if job.device_start is None:
+                        job.device_start = first
+            if not started:  # in device mode the start message carries the device sample
+                self.broadcast(start_message(job.utterance_id, prep, job.device_start)
+                               .model_dump_json())
+                started = True
             for chunk in batch:
                 lo, hi = mouth.frame_range(0, chunk.end_sample)
                 if hi > sent_frames:
@@ -122,7 +149,19 @@ class Channel:
                 self.broadcast(pack_audio(job.utterance_id, chunk.start_sample,
                                           chunk.samples.astype("<i2").tobytes()))
                 end_sample = chunk.end_sample
+        if not started:
+            self.broadcast(start_message(job.utterance_id, prep, job.device_start)
+                           .model_dump_json())
         stopped = job.stop.is_set() and end_sample < prep.num_samples
+        if job.device_stopped_at is not None and job.device_start is not None:
+            # device mode: the cut is where the speaker actually stopped
+            end_sample = max(0, min(end_sample, job.device_stopped_at - job.device_start))
+            stopped = True
+        elif self.device is not None and job.device_start is not None:
+            pos = self.device.position()[0]
+            self.on_device = [j for j in self.on_device if j.device_start is not None and
+                              j.device_start + j.prepared.num_samples > pos]
+            self.on_device.append(job)
         self.broadcast(End(utterance_id=job.utterance_id, end_sample=end_sample,
                            stopped=stopped).model_dump_json())
 
@@ -131,12 +170,12 @@ def _take(chunks: Any, n: int) -> list[Any]:
     return [c for c in itertools.islice(chunks, n)]
 
 
-def start_message(uid: int, prep: Prepared) -> Start:
+def start_message(uid: int, prep: Prepared, device_start: int | None = None) -> Start:
     m = prep.marks(mouth=False)
     return Start(utterance_id=uid, sample_rate=prep.sample_rate, num_samples=prep.num_samples,
                  text=prep.text, voice=prep.voice, words=m["words"], phones=m["phones"],
                  visemes=m["visemes"], mouth_nodes=list(prep.mouth.nodes),
-                 mouth_rate_hz=prep.mouth.rate_hz)
+                 mouth_rate_hz=prep.mouth.rate_hz, device_start=device_start)
 
 
 def mouth_message(uid: int, prep: Prepared, lo: int, hi: int) -> Mouth:
@@ -152,15 +191,20 @@ def mouth_message(uid: int, prep: Prepared, lo: int, hi: int) -> Mouth:
 class Broker:
     """All channels of this process (the embedded default: no external service)."""
 
-    def __init__(self, max_queued: int) -> None:
+    def __init__(self, max_queued: int, device: Device | None = None) -> None:
         self.channels: dict[str, Channel] = {}
         self.max_queued = max_queued
+        self.device = device
 
     def channel(self, name: str) -> Channel:
         ch = self.channels.get(name)
         if ch is None:
-            ch = self.channels[name] = Channel(name, self.max_queued)
+            ch = self.channels[name] = Channel(name, self.max_queued, self.device)
         return ch
+
+    def broadcast_all(self, item: str | bytes) -> None:
+        for ch in self.channels.values():
+            ch.broadcast(item)
 
     def drop_if_idle(self, name: str) -> None:
         ch = self.channels.get(name)

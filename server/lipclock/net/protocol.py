@@ -79,6 +79,7 @@ class Start(_Msg):
     visemes: list[dict[str, Any]]
     mouth_nodes: list[str]
     mouth_rate_hz: float
+    device_start: int | None = None  # device mode: device sample where sample 0 plays
 
 
 class Mouth(_Msg):
@@ -102,6 +103,14 @@ class End(_Msg):
     stopped: bool = False
 
 
+class Clock(_Msg):
+    """Device mode: the device was playing ``device_sample`` at server time ``server_time_s``."""
+
+    type: Literal["clock"] = "clock"
+    device_sample: int
+    server_time_s: float
+
+
 class Pong(_Msg):
     type: Literal["pong"] = "pong"
     t_client: float
@@ -114,7 +123,7 @@ class Error(_Msg):
     reason: str
 
 
-ServerMessage = Annotated[Hello | Start | Mouth | End | Pong | Error,
+ServerMessage = Annotated[Hello | Start | Mouth | End | Clock | Pong | Error,
                           Field(discriminator="type")]
 SERVER_MESSAGE: TypeAdapter[Any] = TypeAdapter(ServerMessage)
 
