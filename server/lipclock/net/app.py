@@ -26,6 +26,7 @@ from starlette.websockets import WebSocketDisconnect
 import lipclock
 
 from ..config import Settings
+from ..tables import package_file
 from ..errors import LipclockError
 from ..face.models import MOUTH_MODELS
 from ..speech.system_voice import system_voices
@@ -58,7 +59,7 @@ from .protocol import (
 )
 
 log = logging.getLogger("lipclock.server")
-CLIENT_DIR = Path(__file__).resolve().parents[3] / "client"
+CLIENT_DIR = package_file("lipclock.client", "")  # client/ ships inside the wheel
 CHANNEL_RE = re.compile(r"^[A-Za-z0-9_.-]{1,64}$")
 SENTENCE_END = re.compile(r"(?<=[.!?])[\"')\]]*\s+")
 
