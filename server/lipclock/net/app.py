@@ -14,7 +14,6 @@ import logging
 import re
 import time
 from collections.abc import AsyncIterator
-from pathlib import Path
 from typing import Any
 
 from fastapi import FastAPI, Header, Request, WebSocket
@@ -26,11 +25,11 @@ from starlette.websockets import WebSocketDisconnect
 import lipclock
 
 from ..config import Settings
-from ..tables import package_file
 from ..errors import LipclockError
 from ..face.models import MOUTH_MODELS
 from ..speech.system_voice import system_voices
 from ..speech.voices import get_voice, voice_names
+from ..tables import package_file
 from ..utterance import Prepared, wav_bytes
 from .channels import (
     CLOSE_TOO_SLOW,
