@@ -14,17 +14,21 @@ fetch("/voices").then((r) => r.json()).then((v) => {
 });
 
 client.addEventListener("open", () => { $("status").textContent = "connected"; });
+client.addEventListener("hello", () => {   // device mode: the server plays the sound
+  if (client.deviceMode) { $("unlock").hidden = true; $("status").textContent = "connected (device clock)"; }
+});
 client.addEventListener("close", () => { $("status").textContent = "reconnecting…"; });
 client.addEventListener("server-error", (e) => { $("status").textContent = e.detail.reason; });
 client.addEventListener("utterance-start", () => { $("caption").textContent = ""; });
 client.addEventListener("word", (e) => { $("caption").textContent += (e.detail.orth || e.detail.text) + " "; });
 
 async function ensureAudio() {
+  if (client.deviceMode) return true;
   const ok = await client.unlock();
   $("unlock").hidden = ok;
   return ok;
 }
-client.unlock().then((ok) => { $("unlock").hidden = ok; });
+client.unlock().then((ok) => { $("unlock").hidden = ok || client.deviceMode; });
 $("unlock").onclick = ensureAudio;
 $("speak").onclick = async () => {
   await ensureAudio();

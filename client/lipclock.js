@@ -25,7 +25,11 @@ export class LipclockClient extends EventTarget {
   // Browsers only let audio start after a user gesture: call this from a click handler.
   async unlock() {
     if (!this.ctx) this.ctx = new AudioContext({ latencyHint: "interactive" });
-    if (this.ctx.state !== "running") await this.ctx.resume();
+    if (this.ctx.state !== "running") {
+      // Without a user gesture, resume() can stay pending forever: don't wait on it, so
+      // the page can show its "tap to enable sound" prompt instead of failing silently.
+      await Promise.race([this.ctx.resume(), new Promise((r) => setTimeout(r, 300))]);
+    }
     this.dispatchEvent(new Event(this.ctx.state === "running" ? "audio-ready" : "audio-blocked"));
     return this.ctx.state === "running";
   }
@@ -36,7 +40,7 @@ export class LipclockClient extends EventTarget {
   speak(text, opts = {}) { this.send({ type: "speak", text, ...opts }); }
   stop() { this.send({ type: "stop" }); }
 
-  close() { this.closed = true; if (this.ws) this.ws.close(); }
+  close() { this.closed = true; clearInterval(this.pingTimer); if (this.ws) this.ws.close(); }
 
   _connect() {
     const ws = new WebSocket(this.url);
@@ -70,11 +74,18 @@ export class LipclockClient extends EventTarget {
           this.incompatible = true;
         }
         this.sampleRate = m.sample_rate;
+        this.deviceMode = m.clock === "device";
+        if (this.deviceMode) this._startPinging();
+        this.dispatchEvent(new CustomEvent("hello", { detail: m }));
+        break;
+      case "clock":
+        this.devClock = { sample: m.device_sample, serverTime: m.server_time_s };
         break;
       case "start":
         if (this.incompatible) return;
         this._silence("replaced");
         this.utt = { id: m.utterance_id, sr: m.sample_rate, n: m.num_samples, start: m,
+                     deviceStart: m.device_start ?? null,
                      t0: null, sources: [], frames: [], gap: [], rateHz: m.mouth_rate_hz,
                      wordIdx: 0, ended: false, endSample: m.num_samples };
         this.dispatchEvent(new CustomEvent("utterance-start", { detail: m }));
@@ -100,14 +111,32 @@ export class LipclockClient extends EventTarget {
         console.warn(`lipclock: server error ${m.code}: ${m.reason}`);
         this.dispatchEvent(new CustomEvent("server-error", { detail: m }));
         break;
-      case "pong": break;
+      case "pong": {
+        // NTP-style: offset of the server clock from ours, from the lowest-RTT exchanges
+        const now = performance.now() / 1000;
+        const rtt = now - m.t_client;
+        this.pings = (this.pings || []).concat([[rtt, m.server_time_s - (m.t_client + now) / 2]]).slice(-40);
+        const best = [...this.pings].sort((a, b) => a[0] - b[0]).slice(0, Math.max(3, Math.floor(this.pings.length / 4)));
+        const offs = best.map((p) => p[1]).sort((a, b) => a - b);
+        this.serverOffset = offs[Math.floor(offs.length / 2)];
+        break;
+      }
       default:
         console.warn("lipclock: unknown message type", m.type);
     }
   }
 
+  _startPinging() {
+    clearInterval(this.pingTimer);
+    let n = 0;
+    const ping = () => { this.send({ type: "ping", t_client: performance.now() / 1000 }); n++; };
+    for (let i = 0; i < 5; i++) setTimeout(ping, i * 60);   // a quick burst, then 1 Hz
+    this.pingTimer = setInterval(ping, 1000);
+  }
+
   _onAudio(buf) {
     const u = this.utt;
+    if (this.deviceMode) return;    // the server's device plays it
     if (!u || !this.ctx || buf.byteLength < HEADER_BYTES) return;
     const dv = new DataView(buf);
     const magic = String.fromCharCode(dv.getUint8(0), dv.getUint8(1), dv.getUint8(2), dv.getUint8(3));
@@ -145,6 +174,13 @@ export class LipclockClient extends EventTarget {
   // The audio-clock sample being heard now (output latency compensated), or null.
   currentSample() {
     const u = this.utt;
+    if (this.deviceMode) {
+      // the device's sample now, from its last clock message and our offset to the server
+      if (!u || u.silenced || u.deviceStart === null || !this.devClock || this.serverOffset === undefined) return null;
+      const serverNow = performance.now() / 1000 + this.serverOffset;
+      const s = Math.floor(this.devClock.sample + (serverNow - this.devClock.serverTime) * u.sr) - u.deviceStart;
+      return s >= 0 && s < u.endSample ? s : null;
+    }
     if (!u || u.t0 === null || !this.ctx || u.silenced) return null;
     const latency = (this.ctx.outputLatency || this.ctx.baseLatency || 0);
     const s = Math.floor((this.ctx.currentTime - latency - u.t0) * u.sr);
@@ -179,8 +215,12 @@ export class LipclockClient extends EventTarget {
           u.wordIdx++;
         }
       }
-      if (u && u.ended && sample === null && u.t0 !== null && !u.doneFired &&
-          this.ctx && this.ctx.currentTime > u.t0 + u.endSample / u.sr) {
+      const finished = this.deviceMode
+        ? (u && u.ended && sample === null && u.deviceStart !== null && this.devClock &&
+           this.devClock.sample >= u.deviceStart + u.endSample)
+        : (u && u.ended && sample === null && u.t0 !== null &&
+           this.ctx && this.ctx.currentTime > u.t0 + u.endSample / u.sr);
+      if (finished && !u.doneFired) {
         u.doneFired = true;
         this.dispatchEvent(new CustomEvent("utterance-end", { detail: { id: u.id } }));
       }

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import socket
 import subprocess
@@ -23,11 +24,11 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-@pytest.fixture(scope="module")
-def server():
+def start_server(env: dict[str, str] | None = None):
     port = free_port()
     exe = Path(sys.executable).with_name("lipclock")
     proc = subprocess.Popen([str(exe), "serve", "--port", str(port)],
+                            env={**os.environ, **(env or {})},
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     url = f"http://127.0.0.1:{port}"
     for _ in range(200):
@@ -39,22 +40,43 @@ def server():
     else:
         proc.kill()
         raise RuntimeError("server did not start")
+    return url, proc
+
+
+@pytest.fixture(scope="module")
+def server():
+    url, proc = start_server()
     yield url
     proc.terminate()
     proc.wait(timeout=10)
 
 
 @pytest.fixture(scope="module")
-def browser():
+def device_server():
+    url, proc = start_server({"LIPCLOCK_CLOCK": "device", "LIPCLOCK_AUDIO_DEVICE": "simulated"})
+    yield url
+    proc.terminate()
+    proc.wait(timeout=10)
+
+
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--no-first-run"]
+
+
+@pytest.fixture(scope="module")
+def playwright():
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=[
-            "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-            "--disable-component-update", "--disable-sync", "--no-first-run",
-            "--autoplay-policy=no-user-gesture-required"])
-        yield b
-        b.close()
+        yield p
+
+
+@pytest.fixture(scope="module")
+def browser(playwright):
+    b = playwright.chromium.launch(executable_path=CHROMIUM,
+                                   args=[*ARGS, "--autoplay-policy=no-user-gesture-required"])
+    yield b
+    b.close()
 
 
 def test_page_speaks_and_the_mouth_moves_on_the_audio_clock(server, browser):
@@ -93,4 +115,79 @@ def test_kiosk_page_loads_clean(server, browser):
     page.wait_for_timeout(500)
     assert page.evaluate("typeof window.lipclockDebug.audioSample") == "number"
     assert not errors
+    page.close()
+
+
+def test_barge_in_silences_and_closes_the_mouth_within_a_frame(server, browser):
+    page = browser.new_page()
+    page.goto(server + "/")
+    page.wait_for_function("document.getElementById('status').textContent === 'connected'")
+    page.fill("#text", "This is a long answer that the user will interrupt. " * 6)
+    page.click("#speak")
+    page.wait_for_function("window.lipclockDebug.audioSample > 8000", timeout=15000)
+    page.evaluate("""() => {
+        window.stopSeen = null; window.closedAt = null;
+        window.lipclockClient.addEventListener('stop',
+            () => { window.stopSeen = performance.now(); });
+        const watch = () => {
+            if (window.stopSeen !== null && window.closedAt === null &&
+                window.lipclockDebug.lipGap === 0 && window.lipclockDebug.audioSample === 0)
+                window.closedAt = performance.now();
+            requestAnimationFrame(watch);
+        };
+        requestAnimationFrame(watch);
+    }""")
+    page.click("#stop")
+    page.wait_for_function("window.closedAt !== null", timeout=5000)
+    lag_ms = page.evaluate("window.closedAt - window.stopSeen")
+    assert lag_ms <= 1000 / 60 + 1  # closed on the next animation frame
+    page.close()
+
+
+def test_device_clock_mode_draws_the_mouth_from_the_servers_clock(device_server, browser):
+    page = browser.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.goto(device_server + "/")
+    page.wait_for_function("document.getElementById('status').textContent"
+                           " === 'connected (device clock)'")
+    assert page.is_hidden("#unlock")  # the server plays the sound: no prompt
+    page.click("#speak")
+    page.wait_for_function("window.lipclockDebug.audioSample > 4000", timeout=15000)
+    gaps = []
+    for _ in range(30):
+        gaps.append(page.evaluate("window.lipclockDebug.lipGap"))
+        page.wait_for_timeout(30)
+    assert max(gaps) > 3.0
+    assert not errors, errors
+    page.close()
+
+
+BLOCKING_AUDIO = """
+// Headless Chromium does not enforce the autoplay policy, so emulate a browser that does:
+// the context stays suspended, and resume() never settles, until there is a user gesture.
+const Real = window.AudioContext;
+window.AudioContext = class extends Real {
+  constructor(...a) { super(...a); this._blocked = true; }
+  get state() { return this._blocked ? "suspended" : super.state; }
+  resume() {
+    if (navigator.userActivation && navigator.userActivation.isActive) {
+      this._blocked = false;
+      return super.resume();
+    }
+    return new Promise(() => {});
+  }
+};
+"""
+
+
+def test_blocked_autoplay_shows_a_tap_to_enable_prompt(server, browser):
+    page = browser.new_page()
+    page.add_init_script(BLOCKING_AUDIO)
+    page.goto(server + "/")
+    page.wait_for_function("document.getElementById('status').textContent === 'connected'")
+    page.wait_for_function("document.getElementById('unlock').hidden === false", timeout=5000)
+    assert "enable sound" in page.inner_text("#unlock").lower()
+    page.click("#unlock")  # a real gesture unlocks audio
+    page.wait_for_function("document.getElementById('unlock').hidden === true", timeout=5000)
     page.close()

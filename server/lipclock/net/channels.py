@@ -13,6 +13,7 @@ import asyncio
 import contextlib
 import itertools
 import logging
+import time
 from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Any
@@ -60,6 +61,22 @@ class Job:
     stop: asyncio.Event = field(default_factory=asyncio.Event)
     device_start: int | None = None
     device_stopped_at: int | None = None
+    first_sent_at: float | None = None  # monotonic time the first audio went out
+
+    def cut_sample(self, device_at: int | None, now: float) -> int | None:
+        """Where a stop at this moment cuts this utterance, or None if it has finished.
+
+        Device mode: the device position. Client mode: the server cannot see the
+        browsers' clocks, so it estimates from the time since the first audio went out;
+        clients stop at once on a stopped end anyway."""
+        n = self.prepared.num_samples
+        if device_at is not None and self.device_start is not None:
+            cut = device_at - self.device_start
+        elif self.first_sent_at is not None:
+            cut = int((now - self.first_sent_at) * self.prepared.sample_rate)
+        else:
+            return None
+        return max(0, cut) if cut < n else None
 
 
 class Channel:
@@ -70,7 +87,7 @@ class Channel:
         self.pending: asyncio.Queue[Job] = asyncio.Queue(maxsize=max_queued)
         self.current: Job | None = None
         self.worker: asyncio.Task[None] | None = None
-        self.on_device: list[Job] = []  # device mode: streamed, maybe still playing
+        self.streamed: list[Job] = []  # fully streamed, maybe still playing
 
     def broadcast(self, item: str | bytes) -> None:
         for sub in list(self.subscribers):
@@ -93,17 +110,15 @@ class Channel:
         if self.current is not None:
             self.current.stop.set()
             self.current.device_stopped_at = at
-        if at is not None:
-            # device mode: utterances already streamed may still be playing or queued on
-            # the device; tell every display where each was cut
-            for job in self.on_device:
-                if job is self.current or job.device_start is None:
-                    continue
-                if at < job.device_start + job.prepared.num_samples:
-                    cut = max(0, at - job.device_start)
-                    self.broadcast(End(utterance_id=job.utterance_id, end_sample=cut,
-                                       stopped=True).model_dump_json())
-            self.on_device.clear()
+        # Streaming runs far ahead of playback, so utterances already streamed may still be
+        # playing (or queued on the device): tell every client where each was cut.
+        now = time.monotonic()
+        for job in self.streamed:
+            cut = job.cut_sample(at, now)
+            if cut is not None:
+                self.broadcast(End(utterance_id=job.utterance_id, end_sample=cut,
+                                   stopped=True).model_dump_json())
+        self.streamed.clear()
 
     async def _run(self) -> None:
         while not self.pending.empty():
@@ -140,6 +155,7 @@ class Channel:
                 self.broadcast(start_message(job.utterance_id, prep, job.device_start)
                                .model_dump_json())
                 started = True
+                job.first_sent_at = time.monotonic()
             for chunk in batch:
                 lo, hi = mouth.frame_range(0, chunk.end_sample)
                 if hi > sent_frames:
@@ -157,11 +173,11 @@ class Channel:
             # device mode: the cut is where the speaker actually stopped
             end_sample = max(0, min(end_sample, job.device_stopped_at - job.device_start))
             stopped = True
-        elif self.device is not None and job.device_start is not None:
-            pos = self.device.position()[0]
-            self.on_device = [j for j in self.on_device if j.device_start is not None and
-                              j.device_start + j.prepared.num_samples > pos]
-            self.on_device.append(job)
+        elif not stopped:
+            at = self.device.position()[0] if self.device is not None else None
+            now = time.monotonic()
+            self.streamed = [j for j in self.streamed if j.cut_sample(at, now) is not None]
+            self.streamed.append(job)
         self.broadcast(End(utterance_id=job.utterance_id, end_sample=end_sample,
                            stopped=stopped).model_dump_json())
 
