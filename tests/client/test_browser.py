@@ -86,8 +86,25 @@ def test_page_speaks_and_the_mouth_moves_on_the_audio_clock(server, browser):
     page.on("pageerror", lambda e: errors.append(str(e)))
     page.goto(server + "/")
     page.wait_for_function("document.getElementById('status').textContent === 'connected'")
+    page.evaluate("""async () => {   // a WebAudio tap: every source passes an analyser
+        const c = window.lipclockClient;
+        await c.unlock();
+        const tap = c.ctx.createAnalyser();
+        tap.fftSize = 2048;
+        tap.connect(c.ctx.destination);
+        c.tap = tap;
+        window.peakLevel = 0;
+        const buf = new Float32Array(tap.fftSize);
+        const watch = () => {
+            tap.getFloatTimeDomainData(buf);
+            for (const v of buf) window.peakLevel = Math.max(window.peakLevel, Math.abs(v));
+            requestAnimationFrame(watch);
+        };
+        requestAnimationFrame(watch);
+    }""")
     page.click("#speak")
     page.wait_for_function("window.lipclockDebug.audioSample > 4000", timeout=15000)
+    page.wait_for_function("window.peakLevel > 0.05", timeout=5000)  # real samples flow
     samples = []
     for _ in range(40):
         samples.append(page.evaluate(
