@@ -24,8 +24,8 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def start_server(env: dict[str, str] | None = None):
-    port = free_port()
+def start_server(env: dict[str, str] | None = None, port: int | None = None):
+    port = port or free_port()
     exe = Path(sys.executable).with_name("lipclock")
     proc = subprocess.Popen([str(exe), "serve", "--port", str(port)],
                             env={**os.environ, **(env or {})},
@@ -208,3 +208,27 @@ def test_blocked_autoplay_shows_a_tap_to_enable_prompt(server, browser):
     page.click("#unlock")  # a real gesture unlocks audio
     page.wait_for_function("document.getElementById('unlock').hidden === true", timeout=5000)
     page.close()
+
+
+def test_server_going_away_mid_utterance_closes_the_mouth_and_reconnects(browser):
+    url, proc = start_server()
+    page = browser.new_page()
+    try:
+        page.goto(url + "/")
+        page.wait_for_function("document.getElementById('status').textContent === 'connected'")
+        page.fill("#text", "The server will vanish in the middle of this long sentence. " * 4)
+        page.click("#speak")
+        page.wait_for_function("window.lipclockDebug.audioSample > 4000", timeout=15000)
+        proc.kill()
+        proc.wait(timeout=10)
+        page.wait_for_function("window.lipclockDebug.audioSample === 0 &&"
+                               " window.lipclockDebug.lipGap === 0", timeout=5000)
+        page.wait_for_function("document.getElementById('status').textContent"
+                               ".startsWith('reconnecting')", timeout=5000)
+        url, proc = start_server(port=int(url.rsplit(":", 1)[1]))
+        page.wait_for_function("document.getElementById('status').textContent === 'connected'",
+                               timeout=20000)
+    finally:
+        page.close()
+        proc.terminate()
+        proc.wait(timeout=10)
