@@ -6,12 +6,9 @@ import numpy as np
 import pytest
 
 from lipclock.errors import OutOfRangeError, TableError
-from lipclock.speech.prosody import (
-    ProsodySettings,
-    build_timeline,
-    load_durations,
-    split_phrases,
-)
+from lipclock.speech.durations import load_durations
+from lipclock.speech.phrasing import split_phrases
+from lipclock.speech.prosody import ProsodySettings, build_timeline
 from lipclock.speech.timeline import PhraseKind
 from lipclock.speech.tokens import BreakKind, BreakToken, PronouncedWord
 

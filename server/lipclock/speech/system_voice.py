@@ -112,9 +112,9 @@ def to_arpabet(mnemonic: str) -> tuple[str, ...] | None:
 @cache
 def _inherent_ms() -> dict[str, tuple[float, float]]:
     """(stressed, unstressed) inherent duration per bare phone, from durations.tsv."""
-    from .prosody import load_durations
+    from .durations import duration_table
 
-    table = load_durations(package_file("lipclock.speech", "data/durations.tsv"))
+    table = duration_table()
     return {p: (d.inherent_ms, d.unstressed_inherent_ms) for p, d in table.items()}
 
 
