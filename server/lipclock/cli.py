@@ -17,7 +17,7 @@ from .errors import LipclockError
 Handler = Callable[[argparse.Namespace, Settings], int]
 
 
-def _settings(args: argparse.Namespace, **fields: object) -> Settings:
+def _settings(**fields: object) -> Settings:
     overrides = {k: v for k, v in fields.items() if v is not None}
     return Settings(**overrides)  # type: ignore[arg-type]
 
@@ -45,7 +45,7 @@ def _add_serve(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-ar
 def _serve(args: argparse.Namespace, _: Settings) -> int:
     from .net.app import serve
 
-    serve(_settings(args, host=args.host, port=args.port))
+    serve(_settings(host=args.host, port=args.port))
     return 0
 
 
@@ -86,7 +86,7 @@ def _say(args: argparse.Namespace, base: Settings) -> int:
 
     from . import synthesize
 
-    settings = _settings(args, sample_rate=args.sample_rate)
+    settings = _settings(sample_rate=args.sample_rate)
     utt = synthesize(_read_text(args), voice=args.voice, rate_wpm=args.rate,
                      pitch_hz=args.pitch, mouth_model=args.mouth_model, settings=settings)
     utt.write_wav(args.output)

@@ -25,7 +25,7 @@ from .face.visemes import visemes_for
 from .speech import klatt, tracks
 from .speech.lexicon import Lexicon, default_lexicon, pronounce
 from .speech.normalize import normalize
-from .speech.prosody import PITCH_HZ_RANGE, ProsodySettings, build_timeline
+from .speech.prosody import PITCH_HZ_RANGE, RATE_WPM_RANGE, ProsodySettings, build_timeline
 from .speech.timeline import Timeline
 from .speech.tokens import Pronounced, Token
 from .speech.voices import Voice, get_voice
@@ -174,8 +174,6 @@ def make_request(text: str, *, voice: str | None = None, rate_wpm: float | None 
 
 
 def _checked_rate(wpm: float) -> float:
-    from .speech.prosody import RATE_WPM_RANGE
-
     lo, hi = RATE_WPM_RANGE
     if not (lo <= wpm <= hi):
         raise OutOfRangeError("rate_wpm", wpm, lo, hi)
@@ -184,8 +182,6 @@ def _checked_rate(wpm: float) -> float:
 
 def _voice_rate(wpm: float, voice: Voice) -> float:
     """The voice's ``speed`` scales the requested rate, kept inside the allowed range."""
-    from .speech.prosody import RATE_WPM_RANGE
-
     lo, hi = RATE_WPM_RANGE
     return min(hi, max(lo, wpm * voice.speed))
 
@@ -247,8 +243,3 @@ def prepare_work(text: str, **options: Any) -> Work:
     request = make_request(text, **options)
     stages = SYSTEM_STAGES if request.system_voice else STAGES
     return run_stages(Work(request), stages)
-
-
-def default_lexicon_warm() -> None:
-    """Load the lexicon and compile the synthesizer (call once at server start)."""
-    default_lexicon()

@@ -183,7 +183,7 @@ class Channel:
 
 
 def _take(chunks: Any, n: int) -> list[Any]:
-    return [c for c in itertools.islice(chunks, n)]
+    return list(itertools.islice(chunks, n))
 
 
 def start_message(uid: int, prep: Prepared, device_start: int | None = None) -> Start:

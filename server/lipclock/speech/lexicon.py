@@ -127,16 +127,13 @@ class Lexicon:
         return None
 
     def _compound(self, word: str) -> tuple[str, ...] | None:
-        best: tuple[str, ...] | None = None
+        """Two known words ("chatbot"): the shortest left part of at least 3 letters that
+        splits the word; the right part's primary stress becomes secondary."""
         for i in range(3, len(word) - 2):
             left, right = self._known(word[:i]), self._known(word[i:])
             if left and right:
-                right = tuple(p.replace("1", "2") for p in right)
-                cand = (*left, *right)
-                if best is None or i > 0:
-                    best = cand
-                    break
-        return best
+                return (*left, *(p.replace("1", "2") for p in right))
+        return None
 
 
 @dataclass(frozen=True, slots=True)
