@@ -7,6 +7,7 @@ import shutil
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 import urllib.request
 from pathlib import Path
@@ -25,22 +26,29 @@ def free_port() -> int:
 
 
 def start_server(env: dict[str, str] | None = None, port: int | None = None):
+    """Start `lipclock serve` as a user would; wait for /healthz (a cold first start on a
+    busy machine can take a while), and never leave the process behind on failure."""
     port = port or free_port()
     exe = Path(sys.executable).with_name("lipclock")
+    log = tempfile.TemporaryFile()  # a file, not a pipe: a full pipe would block the server
     proc = subprocess.Popen([str(exe), "serve", "--port", str(port)],
                             env={**os.environ, **(env or {})},
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                            stdout=subprocess.DEVNULL, stderr=log)
     url = f"http://127.0.0.1:{port}"
-    for _ in range(200):
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
         try:
             urllib.request.urlopen(url + "/healthz", timeout=1)
-            break
+            log.close()  # the server keeps its own descriptor
+            return url, proc
         except OSError:
             time.sleep(0.1)
-    else:
-        proc.kill()
-        raise RuntimeError("server did not start")
-    return url, proc
+    proc.kill()
+    proc.wait(timeout=10)
+    with log:
+        log.seek(0)
+        tail = log.read().decode(errors="replace")[-2000:]
+    raise RuntimeError(f"server did not start (exit {proc.returncode}): {tail}")
 
 
 @pytest.fixture(scope="module")
