@@ -29,22 +29,29 @@ __all__ = ["AudioChunk", "LipclockError", "Prepared", "Settings", "Utterance", "
 
 def prepare(text: str, *, voice: str | None = None, rate_wpm: float | None = None,
             pitch_hz: float | None = None, mouth_model: str | None = None,
+            spring_params: dict[str, float] | None = None,
             settings: Settings | None = None) -> Prepared:
-    """Run the front end and mouth models; audio is rendered on demand in chunks."""
+    """Run the front end and mouth models; audio is rendered on demand in chunks.
+
+    ``spring_params`` overrides the spring model's constants for this utterance, keyed
+    as in ``viseme_tables/dynamics.toml`` (``"lips.stiffness"``, ``"jaw.damping"``...)."""
     from .engine import prepare_work
     from .utterance import Prepared
 
     work = prepare_work(text, voice=voice, rate_wpm=rate_wpm, pitch_hz=pitch_hz,
-                        mouth_model=mouth_model, settings=settings)
+                        mouth_model=mouth_model, spring_params=spring_params,
+                        settings=settings)
     return Prepared.from_work(text, work)
 
 
 def synthesize(text: str, *, voice: str | None = None, rate_wpm: float | None = None,
                pitch_hz: float | None = None, mouth_model: str | None = None,
+               spring_params: dict[str, float] | None = None,
                settings: Settings | None = None) -> Utterance:
     """Text -> :class:`Utterance` (samples, phones, words, visemes, mouth, marks())."""
     return prepare(text, voice=voice, rate_wpm=rate_wpm, pitch_hz=pitch_hz,
-                   mouth_model=mouth_model, settings=settings).render()
+                   mouth_model=mouth_model, spring_params=spring_params,
+                   settings=settings).render()
 
 
 def __getattr__(name: str) -> object:

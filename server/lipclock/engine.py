@@ -19,8 +19,9 @@ from typing import Any
 import numpy as np
 
 from .config import Settings
-from .errors import OutOfRangeError
+from .errors import OutOfRangeError, UnknownChoiceError
 from .face.models import mouth_for
+from .face.spring import check_spring_params
 from .face.visemes import visemes_for
 from .speech import klatt, tracks
 from .speech.lexicon import Lexicon, default_lexicon, pronounce
@@ -49,6 +50,7 @@ class Request:
     max_chars: int
     lexicon: Lexicon
     system_voice: str | None = None  # "system:<id>": audio from pyttsx3's engine
+    spring_params: tuple[tuple[str, float], ...] = ()  # dynamics.toml overrides
 
 
 @dataclass(frozen=True)
@@ -85,7 +87,8 @@ def _visemes(w: Work) -> Work:
 def _mouth(w: Work) -> Work:
     assert w.timeline is not None
     r = w.request
-    return replace(w, mouth=mouth_for(w.timeline, model=r.mouth_model, rate_hz=r.mouth_rate_hz))
+    return replace(w, mouth=mouth_for(w.timeline, model=r.mouth_model, rate_hz=r.mouth_rate_hz,
+                                      params=dict(r.spring_params) or None))
 
 
 def _tracks(w: Work) -> Work:
@@ -147,6 +150,7 @@ def run_stages(work: Work, stages: tuple[Stage, ...] = STAGES) -> Work:
 
 def make_request(text: str, *, voice: str | None = None, rate_wpm: float | None = None,
                  pitch_hz: float | None = None, mouth_model: str | None = None,
+                 spring_params: dict[str, float] | None = None,
                  settings: Settings | None = None, lexicon: Lexicon | None = None) -> Request:
     """Resolve the caller's options against Settings and the voice; validate ranges."""
     s = settings or Settings()
@@ -169,8 +173,14 @@ def make_request(text: str, *, voice: str | None = None, rate_wpm: float | None 
         comma_pause_s=s.comma_pause_s,
         period_pause_s=s.period_pause_s,
     )
-    return Request(text, v, prosody, mouth_model or s.mouth_model, s.mouth_rate_hz,
-                   s.max_text_chars, lexicon or _lexicon_for(s), system)
+    model = mouth_model or s.mouth_model
+    if spring_params:
+        if model != "spring":
+            raise UnknownChoiceError("mouth_model for spring_params", model, ("spring",))
+        check_spring_params(spring_params)  # unknown keys and ranges fail here, typed
+    return Request(text, v, prosody, model, s.mouth_rate_hz,
+                   s.max_text_chars, lexicon or _lexicon_for(s), system,
+                   tuple(sorted((spring_params or {}).items())))
 
 
 def _checked_rate(wpm: float) -> float:

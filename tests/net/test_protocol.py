@@ -23,7 +23,9 @@ from lipclock.net.protocol import (
     unpack_audio,
 )
 
-CLIENT = [Speak(text="hi", voice="adult-low", rate_wpm=200), TextAppend(text="Hel"),
+CLIENT = [Speak(text="hi", voice="adult-low", rate_wpm=200),
+          Speak(text="hi", mouth_model="spring", spring_params={"lips.stiffness": 20.0}),
+          TextAppend(text="Hel"),
           TextFlush(), Stop(), Ping(t_client=12.5)]
 SERVER = [Hello(sample_rate=16000, channel="c"),
           Start(utterance_id=3, sample_rate=16000, num_samples=100, text="t", voice="v",

@@ -53,6 +53,22 @@ def test_http_routes(client):
     assert client.get("/docs").status_code == 200
 
 
+def test_spring_constants_per_request_change_the_mouth(client):
+    defaults = client.get("/voices").json()["spring_params"]
+    assert defaults["lips.stiffness"] > 0 and defaults["jaw.damping"] > 0
+    text = "Papa, a big bowl of mashed bananas."
+
+    def gaps(**params):
+        r = client.post("/speak", json={"text": text, "spring_params": params or None})
+        assert r.status_code == 200
+        marks = client.get(r.json()["marks_url"].replace("http://testserver", "")).json()
+        return marks["mouth"]["measures"]["lip_gap"]
+
+    base, stiff = gaps(), gaps(**{"lips.stiffness": 4 * defaults["lips.stiffness"]})
+    assert base == gaps(**{"lips.stiffness": defaults["lips.stiffness"]})  # same constants
+    assert base != stiff and max(stiff) > max(base)  # a stiffer lip spring opens further
+
+
 @pytest.mark.parametrize("payload,status,code", [
     ({"text": ""}, 422, None),
     ({"text": "   "}, 400, "empty_text"),
@@ -60,6 +76,12 @@ def test_http_routes(client):
     ({"text": "hi", "rate_wpm": 9000}, 400, "out_of_range"),
     ({"text": "hi", "channel": "no spaces!"}, 400, "bad_channel"),
     ({"text": "x" * 6000}, 400, "text_too_long"),
+    ({"text": "hi", "spring_params": {"lips.stiffnes": 5}}, 400, "unknown_choice"),
+    ({"text": "hi", "spring_params": {"lips.damping": -2}}, 400, "out_of_range"),
+    ({"text": "hi", "spring_params": {"lips.mass": 1e-4, "lips.stiffness": 1e5}}, 400, "bad_input"),
+    ({"text": "hi", "mouth_model": "linear", "spring_params": {"lips.damping": 1}}, 400,
+     "unknown_choice"),
+    ({"text": "hi", "spring_params": {"lips.damping": "soft"}}, 422, None),
 ])
 def test_http_bad_input_is_4xx_with_reason(client, payload, status, code):
     r = client.post("/speak", json=payload)

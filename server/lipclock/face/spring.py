@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from ..errors import OutOfRangeError, TableError, UnknownChoiceError
+from ..errors import LipclockError, OutOfRangeError, TableError, UnknownChoiceError
 from ..speech.timeline import Timeline
 from ..tables import finite_float, line_of, load_toml, package_file
 from .shape import NODES
@@ -124,6 +124,29 @@ def load_dynamics(path: Path, overrides: dict[str, Any] | None = None) -> Dynami
 @cache
 def default_dynamics() -> Dynamics:
     return load_dynamics(package_file("lipclock.viseme_tables", "dynamics.toml"))
+
+
+def spring_params() -> dict[str, float]:
+    """The constants a caller may override per utterance, keyed as in dynamics.toml."""
+    d = default_dynamics()
+    out = {f"{g}.{k}": v for g, t in d.groups.items() for k, v in t.items()}
+    out.update({"closure.stiffness": d.closure_stiffness, "closure.damping": d.closure_damping,
+                "closure.overshoot_mm": d.overshoot_mm,
+                "neighbours.stiffness": d.neighbour_stiffness})
+    return out
+
+
+def check_spring_params(params: dict[str, Any]) -> None:
+    """Typed errors for unknown keys, out-of-range values and unstable combinations."""
+    d = load_dynamics(package_file("lipclock.viseme_tables", "dynamics.toml"), params)
+    try:
+        check_stability(d, d.step_s)
+    except OutOfRangeError:
+        limit = (0.5 / d.step_s) ** 2
+        raise LipclockError(f"spring_params are unstable at the {d.step_s * 1000:g} ms "
+                            f"integration step: every node's stiffness/mass (neighbour "
+                            f"springs included) must stay below {limit:,.0f} s^-2; lower "
+                            f"a stiffness or raise a mass") from None
 
 
 def check_stability(d: Dynamics, dt: float) -> None:

@@ -19,7 +19,7 @@ from typing import Any
 from fastapi import FastAPI, Header, Request, WebSocket
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, PlainTextResponse, Response
-from pydantic import BaseModel, Field, ValidationError
+from pydantic import Field, ValidationError
 from starlette.websockets import WebSocketDisconnect
 
 import lipclock
@@ -27,6 +27,7 @@ import lipclock
 from ..config import Settings
 from ..errors import LipclockError
 from ..face.models import MOUTH_MODELS
+from ..face.spring import spring_params
 from ..speech.system_voice import system_voices
 from ..speech.voices import get_voice, voice_names
 from ..tables import package_file
@@ -52,6 +53,7 @@ from .protocol import (
     Ping,
     Pong,
     Speak,
+    SpeechOptions,
     Stop,
     TextAppend,
     TextFlush,
@@ -63,13 +65,9 @@ CHANNEL_RE = re.compile(r"^[A-Za-z0-9_.-]{1,64}$")
 SENTENCE_END = re.compile(r"(?<=[.!?])[\"')\]]*\s+")
 
 
-class SpeakRequest(BaseModel):
+class SpeakRequest(SpeechOptions):
     text: str = Field(min_length=1)
-    voice: str | None = None
-    rate_wpm: float | None = None
-    pitch_hz: float | None = None
     channel: str = "default"
-    mouth_model: str | None = None
 
 
 def _error(status: int, code: str, reason: str) -> JSONResponse:
@@ -109,11 +107,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             return "view"
         return None
 
-    async def prepare(text: str, voice: str | None, rate: float | None, pitch: float | None,
-                      model: str | None) -> Prepared:
+    async def prepare(text: str, options: dict[str, Any]) -> Prepared:
         t0 = time.perf_counter()
-        prep = await asyncio.to_thread(lipclock.prepare, text, voice=voice, rate_wpm=rate,
-                                       pitch_hz=pitch, mouth_model=model, settings=s)
+        prep = await asyncio.to_thread(lambda: lipclock.prepare(text, settings=s, **options))
         metrics.observe_prepare(time.perf_counter() - t0, prep.duration_s)
         return prep
 
@@ -146,7 +142,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             return _error(403, "forbidden", "this key may only view")
         if not CHANNEL_RE.match(req.channel):
             return _error(400, "bad_channel", "channel names are 1-64 of A-Z a-z 0-9 _ . -")
-        prep = await prepare(req.text, req.voice, req.rate_wpm, req.pitch_hz, req.mouth_model)
+        prep = await prepare(req.text, req.options())
         uid = next_utterance_id()
         store.put(uid, prep)
         try:
@@ -170,6 +166,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
                             "base_f0_hz": get_voice(n).base_f0_hz} for n in voice_names()],
                 "system_voices": ["system:" + v for v in system_voices()],
                 "default": s.voice, "mouth_models": list(MOUTH_MODELS),
+                "spring_params": spring_params(),
                 "sample_rate": s.sample_rate}
 
     @app.get("/healthz")
@@ -252,10 +249,9 @@ async def serve_socket(websocket: WebSocket, s: Settings, broker: Broker, store:
         metrics.error(code)
         reply(Error(code=code, reason=reason))
 
-    async def say(text: str, voice: str | None = None, rate: float | None = None,
-                  pitch: float | None = None, model: str | None = None) -> None:
+    async def say(text: str, options: dict[str, Any] | None = None) -> None:
         try:
-            prep = await prepare(text, voice, rate, pitch, model)
+            prep = await prepare(text, options or {})
             uid = next_utterance_id()
             store.put(uid, prep)
             channel.enqueue(Job(uid, prep))
@@ -305,7 +301,7 @@ async def serve_socket(websocket: WebSocket, s: Settings, broker: Broker, store:
                 fail("forbidden", "this key may only view")
                 continue
             if isinstance(m, Speak):
-                await say(m.text, m.voice, m.rate_wpm, m.pitch_hz, m.mouth_model)
+                await say(m.text, m.options())
             elif isinstance(m, TextAppend):
                 pending_text += m.text
                 if len(pending_text) > s.max_text_chars:

@@ -24,13 +24,24 @@ class _Msg(BaseModel):
 
 # --- client -> server --------------------------------------------------------
 
-class Speak(_Msg):
-    type: Literal["speak"] = "speak"
-    text: str = Field(min_length=1)
+class SpeechOptions(BaseModel):
+    """How to say it: shared by the WebSocket ``speak`` message and ``POST /speak``."""
+
     voice: str | None = None
     rate_wpm: float | None = None
     pitch_hz: float | None = None
     mouth_model: str | None = None
+    # spring model constants for this utterance, keyed as in viseme_tables/dynamics.toml
+    # ("lips.stiffness": N/m, "lips.damping": N*s/m, ...); GET /voices lists the defaults
+    spring_params: dict[str, float] | None = Field(None, max_length=32)
+
+    def options(self) -> dict[str, Any]:
+        return {k: getattr(self, k) for k in SpeechOptions.model_fields}
+
+
+class Speak(_Msg, SpeechOptions):
+    type: Literal["speak"] = "speak"
+    text: str = Field(min_length=1)
 
 
 class TextAppend(_Msg):
