@@ -25,42 +25,10 @@ import time
 import httpx
 import websockets
 
-from serverutil import free_port, percentile, running_server
+from serverutil import free_port, jitter_proxy, percentile, running_server
 
 SKEW_S = 1234.567  # the display's clock is not the server's
 TEXT = ("This is a long announcement for the kiosk display test. " * 12).strip()
-
-
-async def jitter_proxy(listen_port: int, target_port: int, lo_s: float, hi_s: float,
-                       rng: random.Random) -> asyncio.AbstractServer:
-    async def pipe(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
-        queue: asyncio.Queue[tuple[float, bytes]] = asyncio.Queue()
-        last_due = 0.0
-
-        async def deliver() -> None:
-            while True:
-                due, data = await queue.get()
-                if not data:
-                    writer.close()
-                    return
-                await asyncio.sleep(max(0.0, due - time.monotonic()))
-                writer.write(data)
-                await writer.drain()
-
-        task = asyncio.create_task(deliver())
-        while True:
-            data = await reader.read(65536)
-            last_due = max(last_due, time.monotonic() + rng.uniform(lo_s, hi_s))
-            await queue.put((last_due, data))
-            if not data:
-                break
-        await task
-
-    async def handle(cr: asyncio.StreamReader, cw: asyncio.StreamWriter) -> None:
-        sr, sw = await asyncio.open_connection("127.0.0.1", target_port)
-        await asyncio.gather(pipe(cr, sw), pipe(sr, cw), return_exceptions=True)
-
-    return await asyncio.start_server(handle, "127.0.0.1", listen_port)
 
 
 class ClockView:

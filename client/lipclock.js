@@ -19,6 +19,9 @@ export class LipclockClient extends EventTarget {
     this.backoffMs = 250;
     this.closed = false;
     this.debug = Object.freeze({ audioSample: 0, mouthSample: 0, lipGap: 0 });
+    // audio chunks received, chunks that arrived after their play time (an underrun: the
+    // late part is skipped so the clock stays exact), and per chunk how early it arrived
+    this.stats = { chunks: 0, lateChunks: 0, slackMs: [] };
     this._connect();
   }
 
@@ -153,7 +156,11 @@ export class LipclockClient extends EventTarget {
     src.buffer = audio;
     src.connect(this.tap || this.ctx.destination);
     const when = u.t0 + first / u.sr;
+    this.stats.chunks++;
+    this.stats.slackMs.push(Math.round((when - this.ctx.currentTime) * 1000));
+    if (this.stats.slackMs.length > 2000) this.stats.slackMs.shift();
     if (when < this.ctx.currentTime) {
+      this.stats.lateChunks++;
       // late chunk: play the part still in the future so the clock stays exact
       const late = this.ctx.currentTime - when;
       if (late < audio.duration) src.start(this.ctx.currentTime, late);
@@ -171,19 +178,29 @@ export class LipclockClient extends EventTarget {
     u.silenced = why;
   }
 
-  // The audio-clock sample being heard now (output latency compensated), or null.
-  currentSample() {
+  // The AudioContext time of the sound leaving the speakers at performance time perfMs.
+  // getOutputTimestamp() pairs the two clocks, output latency included; where it is
+  // missing (older Safari) currentTime minus outputLatency is the best estimate.
+  outputTime(perfMs = performance.now()) {
+    const ctx = this.ctx;
+    const ts = ctx.getOutputTimestamp ? ctx.getOutputTimestamp() : null;
+    if (ts && ts.performanceTime > 0) return ts.contextTime + (perfMs - ts.performanceTime) / 1000;
+    const latency = ctx.outputLatency || ctx.baseLatency || 0;
+    return ctx.currentTime - latency + (perfMs - performance.now()) / 1000;
+  }
+
+  // The audio-clock sample being heard at performance time perfMs (default: now), or null.
+  currentSample(perfMs = performance.now()) {
     const u = this.utt;
     if (this.deviceMode) {
-      // the device's sample now, from its last clock message and our offset to the server
+      // the device's sample then, from its last clock message and our offset to the server
       if (!u || u.silenced || u.deviceStart === null || !this.devClock || this.serverOffset === undefined) return null;
-      const serverNow = performance.now() / 1000 + this.serverOffset;
+      const serverNow = perfMs / 1000 + this.serverOffset;
       const s = Math.floor(this.devClock.sample + (serverNow - this.devClock.serverTime) * u.sr) - u.deviceStart;
       return s >= 0 && s < u.endSample ? s : null;
     }
     if (!u || u.t0 === null || !this.ctx || u.silenced) return null;
-    const latency = (this.ctx.outputLatency || this.ctx.baseLatency || 0);
-    const s = Math.floor((this.ctx.currentTime - latency - u.t0) * u.sr);
+    const s = Math.floor((this.outputTime(perfMs) - u.t0) * u.sr);
     if (s < 0 || s >= u.endSample) return null;
     return s;
   }
@@ -202,10 +219,12 @@ export class LipclockClient extends EventTarget {
     return { nodes, names: u.start.mouth_nodes, lipGap: gap, sample: Math.round(k * u.sr / u.rateHz + f * u.sr / u.rateHz) };
   }
 
-  // Call render(state) on every animation frame with {sample, mouth, words}.
+  // Call render({sample, mouth, time}) on every animation frame, for the sample heard at
+  // the frame's time. render may return what it drew ({sample, lipGap, ms}, as face.js's
+  // draw() does); the "frame" event and the debug object then report the drawn values.
   animate(render) {
-    const tick = () => {
-      const sample = this.currentSample();
+    const tick = (time) => {
+      const sample = this.currentSample(time);
       const mouth = this.mouthAt(sample);
       const u = this.utt;
       if (u && sample !== null) {
@@ -224,9 +243,16 @@ export class LipclockClient extends EventTarget {
         u.doneFired = true;
         this.dispatchEvent(new CustomEvent("utterance-end", { detail: { id: u.id } }));
       }
-      this.debug = Object.freeze({ audioSample: sample ?? 0, mouthSample: mouth ? mouth.sample : 0,
-                                   lipGap: mouth ? mouth.lipGap : 0 });
-      render({ sample, mouth });
+      const drawn = render({ sample, mouth, time }) || {};
+      this.debug = Object.freeze({
+        audioSample: sample ?? 0,
+        mouthSample: drawn.sample ?? (mouth ? mouth.sample : 0) ?? 0,
+        lipGap: drawn.lipGap ?? (mouth ? mouth.lipGap : 0),
+        drawMs: drawn.ms ?? null,
+        frameTime: time });
+      this.dispatchEvent(new CustomEvent("frame", { detail: {
+        time, utterance: u ? u.id : null, audioSample: sample, ...this.debug,
+        outputTime: this.ctx && !this.deviceMode ? this.outputTime(time) : null } }));
       requestAnimationFrame(tick);
     };
     requestAnimationFrame(tick);
