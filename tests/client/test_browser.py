@@ -2,81 +2,10 @@
 
 from __future__ import annotations
 
-import os
-import shutil
-import socket
-import subprocess
-import sys
-import time
-import urllib.request
-from pathlib import Path
-
 import pytest
+from browser_util import ARTIFACTS, HAVE_CHROMIUM, start_server
 
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-ARTIFACTS = Path(__file__).resolve().parents[2] / "artifacts" / "screenshots"
-pytestmark = pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="Debian chromium missing")
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def start_server(env: dict[str, str] | None = None, port: int | None = None):
-    port = port or free_port()
-    exe = Path(sys.executable).with_name("lipclock")
-    proc = subprocess.Popen([str(exe), "serve", "--port", str(port)],
-                            env={**os.environ, **(env or {})},
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    url = f"http://127.0.0.1:{port}"
-    for _ in range(200):
-        try:
-            urllib.request.urlopen(url + "/healthz", timeout=1)
-            break
-        except OSError:
-            time.sleep(0.1)
-    else:
-        proc.kill()
-        raise RuntimeError("server did not start")
-    return url, proc
-
-
-@pytest.fixture(scope="module")
-def server():
-    url, proc = start_server()
-    yield url
-    proc.terminate()
-    proc.wait(timeout=10)
-
-
-@pytest.fixture(scope="module")
-def device_server():
-    url, proc = start_server({"LIPCLOCK_CLOCK": "device", "LIPCLOCK_AUDIO_DEVICE": "simulated"})
-    yield url
-    proc.terminate()
-    proc.wait(timeout=10)
-
-
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run"]
-
-
-@pytest.fixture(scope="module")
-def playwright():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        yield p
-
-
-@pytest.fixture(scope="module")
-def browser(playwright):
-    b = playwright.chromium.launch(executable_path=CHROMIUM,
-                                   args=[*ARGS, "--autoplay-policy=no-user-gesture-required"])
-    yield b
-    b.close()
+pytestmark = pytest.mark.skipif(not HAVE_CHROMIUM, reason="Debian chromium missing")
 
 
 def test_page_speaks_and_the_mouth_moves_on_the_audio_clock(server, browser):
