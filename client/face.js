@@ -27,7 +27,8 @@ function loadImage(url) {
 }
 
 // opts: look (default "textured"), mesh (GET /mesh JSON; fetched when absent),
-// meshUrl, textureUrl, random (a () => [0,1) source for blink timing).
+// meshUrl, textureUrl, random (a () => [0,1) source for blink timing), antialias
+// (WebGL MSAA; default off, see face/gl.js).
 export async function createFace(canvas, opts = {}) {
   const meshUrl = opts.meshUrl || "/mesh";
   const textureUrl = opts.textureUrl || new URL("./assets/face.png", import.meta.url).href;
@@ -40,7 +41,7 @@ export async function createFace(canvas, opts = {}) {
   ]);
   const face = buildFace(mouth);
   const rig = new Rig(face);
-  const gl = createGL(canvas);
+  const gl = createGL(canvas, Boolean(opts.antialias));
   let renderer, backend;
   if (gl) {
     renderer = new GLRenderer(canvas, gl, face, image); backend = "webgl";

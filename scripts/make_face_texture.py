@@ -65,7 +65,7 @@ def face_depth(L: dict, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     n, eye = L["nose"], L["eyes"]
     r = np.minimum(1.0, np.abs(x) / (head_half_width(L, y) + 6))
     z = 60 * np.sqrt(1 - r * r)
-    z += 16 * gauss(x - n["tip_mm"][0], y - (n["tip_mm"][1] + 8), 6.5, 15)
+    z += 12 * gauss(x - n["tip_mm"][0], y - (n["tip_mm"][1] + 8), 7.5, 15)
     z += 4 * gauss(np.abs(x) - 30, y - 84, 16, 5)
     z += 5 * gauss(np.abs(x) - 40, y - 40, 12, 12)
     z -= 6 * gauss(np.abs(x) - eye["centre_mm"][0], y - eye["centre_mm"][1], 13, 8)
@@ -126,15 +126,18 @@ def paint_face(L: dict, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     d, t = brow_distance(L, x, y)
     b = L["brows"]
     half = (b["thick_inner_mm"] + (b["thick_outer_mm"] - b["thick_inner_mm"]) * t) / 2
-    strands = 0.85 + 0.15 * np.sin(ax * 3.1 + y * 1.3)
+    strands = 0.92 + 0.08 * np.sin(ax * 3.1 + y * 1.3)
     over(img, [0.3, 0.2, 0.14], 0.95 * smooth(half + 0.6, half - 0.4, d) * strands)
     # hair, with strands that sweep from the parting
     line = hair["line_mm"] - hair["drop_mm"] * (x / hair["side_x_mm"]) ** 2
     mask = np.maximum(smooth(line - 3, line + 4, y),
                       smooth(hair["side_x_mm"] - 4, hair["side_x_mm"] + 3, ax)
                       * smooth(hair["side_y_mm"], hair["side_y_mm"] + 10, y))
-    wave = 0.5 + 0.5 * np.sin(x * 0.9 + 0.02 * (y - 160) ** 2 * np.sign(x + 1e-9))
-    hair_col = HAIR[None, None, :] * (0.8 + 0.45 * wave[..., None])
+    # strands: fine, low-contrast waves sweeping out from the parting, plus a sheen band
+    sweep = x * 2.3 + 0.012 * (y - 170) ** 2 * np.sign(x + 1e-9)
+    wave = 0.5 + 0.25 * np.sin(sweep) + 0.25 * np.sin(1.7 * sweep + 1.3)
+    sheen = 0.35 * gauss(np.hypot(x, y - 60) - 88, 0, 7, 1) * smooth(-70, -10, -np.abs(x))
+    hair_col = HAIR[None, None, :] * (0.85 + 0.25 * wave + sheen)[..., None]
     a = np.clip(mask, 0, 1)[..., None]
     return np.clip(img * (1 - a) + hair_col * a, 0, 1)
 
@@ -149,7 +152,7 @@ def paint_lips(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     over(img, [0.45, 0.15, 0.18], 0.6 * smooth(16, 25, ax))                     # corners
     over(img, [0.97, 0.72, 0.72], 0.45 * gauss(x, y + 4.5, 8, 1.6))             # lower highlight
     over(img, [0.9, 0.6, 0.6], 0.2 * gauss(ax - 6, y - 4, 4, 1.5))              # upper highlights
-    img *= (0.94 + 0.06 * np.sin(x * 2.4))[..., None]                           # fine creases
+    img *= (0.975 + 0.025 * np.sin(x * 2.4))[..., None]                         # fine creases
     return np.clip(img, 0, 1)
 
 

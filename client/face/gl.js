@@ -61,8 +61,11 @@ const LOOKS = {
 };
 export const GL_LOOKS = Object.keys(LOOKS);
 
-export function createGL(canvas) {
-  const opts = { stencil: true, antialias: true, alpha: false, preserveDrawingBuffer: true };
+export function createGL(canvas, antialias = false) {
+  // MSAA off by default: software rasterisers (SwiftShader, GPU-less kiosks) take 2-3x
+  // longer per frame with it, and high-dpi screens hide the aliasing anyway.
+  // preserveDrawingBuffer keeps the last frame readable (screenshots, toDataURL).
+  const opts = { stencil: true, antialias, alpha: false, preserveDrawingBuffer: true };
   return canvas.getContext("webgl", opts) || canvas.getContext("experimental-webgl", opts);
 }
 

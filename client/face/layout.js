@@ -15,8 +15,8 @@
 
 // LAYOUT-JSON-BEGIN
 export const LAYOUT = {
-  "head": {"bottom_mm": -58, "top_mm": 156, "half_width_mm": 74, "widest_y_mm": 40,
-           "jaw_exp": 2.1, "crown_exp": 2.4, "min_half_width_mm": 12},
+  "head": {"bottom_mm": -56, "top_mm": 156, "half_width_mm": 74, "widest_y_mm": 40,
+           "jaw_exp": 2.6, "crown_exp": 2.4, "min_half_width_mm": 14},
   "eyes": {"centre_mm": [31, 64], "half_width_mm": 14, "upper_mm": 6.5, "lower_mm": 4.0,
            "fold_mm": 11.0, "iris_mm": 5.6, "pupil_mm": 2.4},
   "brows": {"inner_mm": [13, 82], "peak_mm": [32, 89], "outer_mm": [48, 83],
@@ -60,7 +60,7 @@ export function faceDepth(x, y) {
   const g = (dx, dy, sx, sy) => Math.exp(-0.5 * ((dx / sx) ** 2 + (dy / sy) ** 2));
   const r = Math.min(1, Math.abs(x) / (hw + 6));
   let z = 60 * Math.sqrt(1 - r * r);
-  z += 16 * g(x - n.tip_mm[0], y - (n.tip_mm[1] + 8), 6.5, 15);   // the nose ridge and tip
+  z += 12 * g(x - n.tip_mm[0], y - (n.tip_mm[1] + 8), 7.5, 15);   // the nose ridge and tip
   z += 4 * g(Math.abs(x) - 30, y - 84, 16, 5);                     // brow ridge
   z += 5 * g(Math.abs(x) - 40, y - 40, 12, 12);                    // cheekbones
   z -= 6 * g(Math.abs(x) - e.centre_mm[0], y - e.centre_mm[1], 13, 8);  // eye sockets

@@ -26,7 +26,7 @@ const gauss = (dx, dy, sx, sy) => Math.exp(-0.5 * ((dx / sx) ** 2 + (dy / sy) **
 // chin; less toward the jaw's angles, which sit closer to the hinge and so drop less.
 export function jawWeight(x, y) {
   const r = x / headHalfWidth(y);
-  return smooth(4, -24, y) * Math.max(0, 1 - 0.7 * r * r);
+  return smooth(4, -24, y) * Math.max(0, 1 - 0.4 * r * r);
 }
 
 // Base colour of the skin at a rest point in the shaded look: hair, blush, eye shadow.
@@ -36,8 +36,8 @@ function skinColour(x, y) {
   c = mix(c, [0.9, 0.55, 0.5], 0.55 * gauss(Math.abs(x) - 40, y - 22, 12, 9));   // cheeks
   c = mix(c, [0.78, 0.58, 0.5], 0.5 * gauss(Math.abs(x) - e.centre_mm[0], y - e.centre_mm[1] - 6, 14, 5));
   const line = h.line_mm - h.drop_mm * (x / h.side_x_mm) ** 2;
-  const hair = Math.max(smooth(line - 3, line + 3, y),
-                        smooth(h.side_x_mm - 4, h.side_x_mm + 2, Math.abs(x)) * smooth(h.side_y_mm, h.side_y_mm + 8, y));
+  const hair = Math.max(smooth(line - 5, line + 5, y),
+                        smooth(h.side_x_mm - 9, h.side_x_mm + 3, Math.abs(x)) * smooth(h.side_y_mm - 4, h.side_y_mm + 12, y));
   return mix(c, HAIR, hair);
 }
 
