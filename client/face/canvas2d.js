@@ -39,11 +39,9 @@ export class Canvas2DRenderer {
     ctx.fillRect(0, 0, c.width, c.height);
     if (look === "wireframe") return this._wire(ctx, f, X, Y, path, s);
 
-    // body
-    const body = f.layers.body;   // neck quad, then the shirt
+    // body: buildFace() makes it first, so vertices 0-3 are the neck, 4-9 the shirt
     fill([0, 1, 2, 3], rgb([0.8, 0.6, 0.48]));
     fill([4, 5, 6, 7, 8, 9], rgb([0.24, 0.33, 0.47]));
-    void body;
     // head
     const img = look === "textured" && this.image;
     if (img) {
