@@ -1,51 +1,109 @@
-// A frontal 2-D face whose mouth is the streamed node mesh (canvas 2-D).
-// Node names come from the server (viseme_tables / face/shape.py); coordinates are mm,
-// y up, origin at the mouth centre.
+// The talking face (issue #6): a DECface-style mesh (Waters & Levergood 1993) whose mouth
+// is the streamed node mesh, with a jaw, teeth, blinking eyes, brows and linear-muscle
+// expressions, drawn in WebGL (canvas 2-D when WebGL is missing).
+//
+//   const face = await createFace(canvas, { look: "textured" });
+//   face.setExpression({ smile: 0.5 });
+//   const drawn = face.draw(client.mouthAt(sample), performance.now());  // {lipGap, sample, ms}
+//
+// Parts: face/layout.js (where features are), face/mesh.js (mesh + rig), face/muscles.js
+// (the muscle table), face/gl.js and face/canvas2d.js (renderers).
 
-const order = (prefix, n) => Array.from({ length: n }, (_, i) => `${prefix}_${i}`);
+import { buildFace, Rig } from "./face/mesh.js";
+import { EXPRESSIONS } from "./face/muscles.js";
+import { GLRenderer, GL_LOOKS, createGL } from "./face/gl.js";
+import { Canvas2DRenderer, C2D_LOOKS } from "./face/canvas2d.js";
 
-export function drawFace(ctx, w, h, mouth, opts = {}) {
-  const scale = Math.min(w, h) / 160;       // mm -> px
-  const cx = w / 2, cy = h * 0.66;
-  const P = (p) => [cx + p[0] * scale, cy - p[1] * scale];
-  ctx.clearRect(0, 0, w, h);
-  // head
-  ctx.fillStyle = "#f1c9a5";
-  ctx.beginPath();
-  ctx.ellipse(w / 2, h * 0.5, 62 * scale, 78 * scale, 0, 0, Math.PI * 2);
-  ctx.fill();
-  // eyes (blink)
-  const blink = opts.blink ? 0.1 : 1;
-  ctx.fillStyle = "#2b2b2b";
-  for (const sx of [-1, 1]) {
-    ctx.beginPath();
-    ctx.ellipse(w / 2 + sx * 24 * scale, h * 0.4, 6 * scale, 4 * scale * blink, 0, 0, Math.PI * 2);
-    ctx.fill();
+const BLINK_CLOSE_MS = 60, BLINK_OPEN_MS = 90;       // ~150 ms a blink, closing faster
+const BLINK_GAP_MS = [2000, 8000];                    // people blink every 2-8 s at rest
+
+function loadImage(url) {
+  return new Promise((resolve) => {
+    const img = new Image();
+    img.onload = () => resolve(img);
+    img.onerror = () => { console.warn(`lipclock face: texture ${url} did not load; textured look falls back to colours`); resolve(null); };
+    img.src = url;
+  });
+}
+
+// opts: look (default "textured"), mesh (GET /mesh JSON; fetched when absent),
+// meshUrl, textureUrl, random (a () => [0,1) source for blink timing), antialias
+// (WebGL MSAA; default off, see face/gl.js).
+export async function createFace(canvas, opts = {}) {
+  const meshUrl = opts.meshUrl || "/mesh";
+  const textureUrl = opts.textureUrl || new URL("./assets/face.png", import.meta.url).href;
+  const [mouth, image] = await Promise.all([
+    opts.mesh ? Promise.resolve(opts.mesh) : fetch(meshUrl).then((r) => {
+      if (!r.ok) throw new Error(`lipclock face: ${meshUrl} answered ${r.status}`);
+      return r.json();
+    }),
+    loadImage(textureUrl),
+  ]);
+  const face = buildFace(mouth);
+  const rig = new Rig(face);
+  const gl = createGL(canvas, Boolean(opts.antialias));
+  let renderer, backend;
+  if (gl) {
+    renderer = new GLRenderer(canvas, gl, face, image); backend = "webgl";
+  } else {
+    renderer = new Canvas2DRenderer(canvas, canvas.getContext("2d"), face, image); backend = "canvas2d";
   }
-  if (!mouth) {             // at rest: closed lips
-    ctx.strokeStyle = "#b5495b"; ctx.lineWidth = 5 * scale;
-    ctx.beginPath(); ctx.moveTo(cx - 25 * scale, cy); ctx.quadraticCurveTo(cx, cy + 3 * scale, cx + 25 * scale, cy); ctx.stroke();
-    return;
+  const looks = backend === "webgl" ? GL_LOOKS : C2D_LOOKS;
+  const random = opts.random || Math.random;
+  const expr = { smile: 0, brow: 0, frown: 0 };
+  const warned = new Set();
+  let look = looks.includes(opts.look) ? opts.look : "textured";
+  let blinkAt = null, nextBlink = null;
+
+  function setLook(name) {
+    if (looks.includes(name)) { look = name; return; }
+    if (!warned.has(name)) { warned.add(name); console.warn(`lipclock face: unknown look ${JSON.stringify(name)}; looks are ${looks.join(", ")}`); }
   }
-  const byName = new Map(mouth.names.map((n, i) => [n, mouth.nodes[i]]));
-  const get = (n) => byName.get(n);
-  const contour = (names) => names.map(get).filter(Boolean).map(P);
-  const outer = [get("corner_l"), ...order("outer_upper", 5).map(get), get("corner_r"),
-                 ...order("outer_lower", 5).reverse().map(get)].filter(Boolean).map(P);
-  const inner = [get("corner_l"), ...order("inner_upper", 5).map(get), get("corner_r"),
-                 ...order("inner_lower", 5).reverse().map(get)].filter(Boolean).map(P);
-  const poly = (pts) => { ctx.beginPath(); pts.forEach((p, i) => i ? ctx.lineTo(...p) : ctx.moveTo(...p)); ctx.closePath(); };
-  ctx.fillStyle = "#b5495b"; poly(outer); ctx.fill();
-  ctx.fillStyle = "#3a1010"; poly(inner); ctx.fill();
-  ctx.save(); poly(inner); ctx.clip();
-  ctx.fillStyle = "#fafafa";
-  const tu = contour(["teeth_upper_l", "teeth_upper_c", "teeth_upper_r"]);
-  const tl = contour(["teeth_lower_l", "teeth_lower_c", "teeth_lower_r"]);
-  if (tu.length === 3) ctx.fillRect(tu[0][0], tu[0][1] - 6 * scale, tu[2][0] - tu[0][0], 6 * scale);
-  if (tl.length === 3) ctx.fillRect(tl[0][0], tl[0][1], tl[2][0] - tl[0][0], 5 * scale);
-  ctx.restore();
-  if (opts.wireframe) {
-    ctx.strokeStyle = "#0a6"; ctx.lineWidth = 1;
-    for (const p of mouth.nodes.map(P)) { ctx.beginPath(); ctx.arc(p[0], p[1], 2, 0, 7); ctx.stroke(); }
+  if (opts.look !== undefined && !looks.includes(opts.look)) setLook(opts.look);
+
+  function blinkAmount(now) {
+    if (nextBlink === null) nextBlink = now + BLINK_GAP_MS[0] * random();
+    if (blinkAt === null && now >= nextBlink) blinkAt = now;
+    if (blinkAt === null) return 0;
+    const t = now - blinkAt;
+    if (t >= BLINK_CLOSE_MS + BLINK_OPEN_MS || t < 0) {
+      blinkAt = null;
+      nextBlink = now + BLINK_GAP_MS[0] + (BLINK_GAP_MS[1] - BLINK_GAP_MS[0]) * random();
+      return 0;
+    }
+    return t < BLINK_CLOSE_MS ? t / BLINK_CLOSE_MS : 1 - (t - BLINK_CLOSE_MS) / BLINK_OPEN_MS;
   }
+
+  function fitCanvas() {            // follow the element's size; reallocates only on change
+    const dpr = Math.min(window.devicePixelRatio || 1, 2);
+    const w = Math.max(1, Math.round(canvas.clientWidth * dpr)), h = Math.max(1, Math.round(canvas.clientHeight * dpr));
+    if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
+  }
+
+  const drawn = { lipGap: 0, sample: null, ms: 0 };
+  return {
+    looks: [...looks],
+    backend,
+    get look() { return look; },
+    setLook,
+    setExpression(e) {
+      for (const k of EXPRESSIONS) {
+        if (e && e[k] !== undefined) { const v = Number(e[k]); if (Number.isFinite(v)) expr[k] = Math.min(1, Math.max(0, v)); }
+      }
+    },
+    get expression() { return { ...expr }; },
+    draw(m, nowMs = performance.now()) {
+      const t0 = performance.now();
+      fitCanvas();
+      rig.update(m, expr, blinkAmount(nowMs));
+      renderer.render(rig, look);
+      drawn.lipGap = rig.lipGap; drawn.sample = m ? m.sample : null;
+      drawn.ms = performance.now() - t0;
+      return { lipGap: drawn.lipGap, sample: drawn.sample, ms: drawn.ms };
+    },
+    // debug accessors (tests, tools): the mouth nodes as last drawn, in GET /mesh order
+    nodeNames: [...face.names],
+    nodePositions() { return rig.nodePositions(); },
+    blinkNow() { nextBlink = -Infinity; },
+  };
 }

@@ -2,89 +2,10 @@
 
 from __future__ import annotations
 
-import os
-import shutil
-import socket
-import subprocess
-import sys
-import tempfile
-import time
-import urllib.request
-from pathlib import Path
-
 import pytest
+from browser_util import ARTIFACTS, HAVE_CHROMIUM, start_server
 
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-ARTIFACTS = Path(__file__).resolve().parents[2] / "artifacts" / "screenshots"
-pytestmark = pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="Debian chromium missing")
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def start_server(env: dict[str, str] | None = None, port: int | None = None):
-    """Start `lipclock serve` as a user would; wait for /healthz (a cold first start on a
-    busy machine can take a while), and never leave the process behind on failure."""
-    port = port or free_port()
-    exe = Path(sys.executable).with_name("lipclock")
-    log = tempfile.TemporaryFile()  # a file, not a pipe: a full pipe would block the server
-    proc = subprocess.Popen([str(exe), "serve", "--port", str(port)],
-                            env={**os.environ, **(env or {})},
-                            stdout=subprocess.DEVNULL, stderr=log)
-    url = f"http://127.0.0.1:{port}"
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and proc.poll() is None:
-        try:
-            urllib.request.urlopen(url + "/healthz", timeout=1)
-            log.close()  # the server keeps its own descriptor
-            return url, proc
-        except OSError:
-            time.sleep(0.1)
-    proc.kill()
-    proc.wait(timeout=10)
-    with log:
-        log.seek(0)
-        tail = log.read().decode(errors="replace")[-2000:]
-    raise RuntimeError(f"server did not start (exit {proc.returncode}): {tail}")
-
-
-@pytest.fixture(scope="module")
-def server():
-    url, proc = start_server()
-    yield url
-    proc.terminate()
-    proc.wait(timeout=10)
-
-
-@pytest.fixture(scope="module")
-def device_server():
-    url, proc = start_server({"LIPCLOCK_CLOCK": "device", "LIPCLOCK_AUDIO_DEVICE": "simulated"})
-    yield url
-    proc.terminate()
-    proc.wait(timeout=10)
-
-
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run"]
-
-
-@pytest.fixture(scope="module")
-def playwright():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        yield p
-
-
-@pytest.fixture(scope="module")
-def browser(playwright):
-    b = playwright.chromium.launch(executable_path=CHROMIUM,
-                                   args=[*ARGS, "--autoplay-policy=no-user-gesture-required"])
-    yield b
-    b.close()
+pytestmark = pytest.mark.skipif(not HAVE_CHROMIUM, reason="Debian chromium missing")
 
 
 def test_page_speaks_and_the_mouth_moves_on_the_audio_clock(server, browser):

@@ -51,6 +51,9 @@ def test_http_routes(client):
     assert r.headers["content-type"] == "audio/wav" and "x-marks-url" in r.headers
     assert "lipclock_utterances_total 2" in client.get("/metrics").text
     assert client.get("/docs").status_code == 200
+    mesh = client.get("/mesh").json()
+    assert mesh["units"] == "mm" and mesh["nodes"][:2] == ["corner_l", "corner_r"]
+    assert len(mesh["rest"]) == len(mesh["nodes"]) and mesh["triangles"] and mesh["edges"]
 
 
 def test_spring_constants_per_request_change_the_mouth(client):

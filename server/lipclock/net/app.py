@@ -1,6 +1,6 @@
 """The HTTP/WebSocket server: a thin edge that turns wire messages into core calls.
 
-Routes: POST /speak, GET /voices, /healthz, /metrics, /utterances/{id}.wav,
+Routes: POST /speak, GET /voices, /mesh, /healthz, /metrics, /utterances/{id}.wav,
 /utterances/{id}/marks.json, / and /kiosk (the browser client), WebSocket /ws.
 Synthesis runs in worker threads so the event loop stays responsive.
 """
@@ -26,6 +26,7 @@ import lipclock
 
 from ..config import Settings
 from ..errors import LipclockError
+from ..face.mesh import mesh_json
 from ..face.models import MOUTH_MODELS
 from ..face.spring import spring_params
 from ..speech.system_voice import system_voices
@@ -168,6 +169,10 @@ def create_app(settings: Settings | None = None) -> FastAPI:
                 "default": s.voice, "mouth_models": list(MOUTH_MODELS),
                 "spring_params": spring_params(),
                 "sample_rate": s.sample_rate}
+
+    @app.get("/mesh", summary="The mouth-node mesh: names, rest positions, edges, triangles")
+    async def mesh() -> dict[str, Any]:
+        return mesh_json()
 
     @app.get("/healthz")
     async def healthz() -> dict[str, Any]:
