@@ -50,8 +50,8 @@ fetch("/voices").then((r) => r.json()).then((v) => {
 const factor = (id) => 2 ** Number($(id).value);
 function showSprings() {
   $("springs").disabled = $("model").value !== "spring";
-  $("stiffnessOut").value = factor("stiffness").toFixed(2);
-  $("dampingOut").value = factor("damping").toFixed(2);
+  $("stiffnessOut").value = "×" + factor("stiffness").toFixed(2);
+  $("dampingOut").value = "×" + factor("damping").toFixed(2);
 }
 for (const id of ["model", "stiffness", "damping"]) $(id).addEventListener("input", showSprings);
 $("model").addEventListener("change", showSprings);

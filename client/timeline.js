@@ -41,9 +41,10 @@ export function createTimeline(canvas, { windowS = 2.5, leadFraction = 0.35 } = 
         const x0 = x(it.start), x1 = x(it.end);
         ctx.strokeStyle = COLORS.grid;
         ctx.strokeRect(x0, y + 2, x1 - x0, rowH - 4);
-        if (x1 - x0 > 14) {
+        const label = String(it[key]).replace(/\d$/, "");
+        if (ctx.measureText(label).width + 4 < x1 - x0) {   // a label only where it fits
           ctx.fillStyle = it.start <= sample && sample < it.end ? color : COLORS.text;
-          ctx.fillText(String(it[key]).replace(/\d$/, ""), (x0 + x1) / 2, y + rowH / 2);
+          ctx.fillText(label, (x0 + x1) / 2, y + rowH / 2);
         }
       }
     };

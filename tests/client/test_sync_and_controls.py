@@ -78,7 +78,7 @@ def test_spring_sliders_send_scaled_constants_only_for_the_spring_model(server, 
     assert params["lips.stiffness"] == pytest.approx(2 * defaults["lips.stiffness"])
     assert params["jaw.damping"] == pytest.approx(0.5 * defaults["jaw.damping"])
     assert "skull.stiffness" not in params and "lips.mass" not in params
-    assert page.inner_text("#stiffnessOut") == "2.00"
+    assert page.inner_text("#stiffnessOut") == "×2.00"
 
     page.select_option("#model", "linear")
     assert page.eval_on_selector("#springs", "f => f.disabled")
