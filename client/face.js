@@ -4,7 +4,7 @@
 //
 //   const face = await createFace(canvas, { look: "textured" });
 //   face.setExpression({ smile: 0.5 });
-//   const drawn = face.draw(client.mouthAt(sample), performance.now());  // {lipGap, sample, ms}
+//   const drawn = face.draw(client.mouthAt(sample), performance.now());  // {lipGap, sample, ms, blink}
 //
 // Parts: face/layout.js (where features are), face/mesh.js (mesh + rig), face/muscles.js
 // (the muscle table), face/gl.js and face/canvas2d.js (renderers).
@@ -95,11 +95,12 @@ export async function createFace(canvas, opts = {}) {
     draw(m, nowMs = performance.now()) {
       const t0 = performance.now();
       fitCanvas();
-      rig.update(m, expr, blinkAmount(nowMs));
+      const blink = blinkAmount(nowMs);
+      rig.update(m, expr, blink);
       renderer.render(rig, look);
       drawn.lipGap = rig.lipGap; drawn.sample = m ? m.sample : null;
       drawn.ms = performance.now() - t0;
-      return { lipGap: drawn.lipGap, sample: drawn.sample, ms: drawn.ms };
+      return { lipGap: drawn.lipGap, sample: drawn.sample, ms: drawn.ms, blink };
     },
     // debug accessors (tests, tools): the mouth nodes as last drawn, in GET /mesh order
     nodeNames: [...face.names],

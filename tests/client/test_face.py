@@ -151,3 +151,48 @@ def test_without_webgl_every_look_draws_in_canvas_2d(server, browser):
         wait_until_silent(page)
     assert not page.errors, page.errors
     page.close()
+
+
+BLINKS = """async () => {
+  // a second face on its own canvas, a seeded random source and a synthetic clock:
+  // 60 s of frames at 60 Hz, recording how shut the eyes were drawn on each
+  const { createFace } = await import('/client/face.js');
+  const canvas = document.createElement('canvas');
+  canvas.style.cssText = 'width:300px;height:300px;position:fixed;left:0;top:0';
+  document.body.appendChild(canvas);
+  let seed = 12345;
+  const random = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
+  const face = await createFace(canvas, { look: 'shaded', random });
+  const blink = [];
+  let open = null, shut = null;
+  for (let t = 0; t < 60000; t += 1000 / 60) {
+    const b = face.draw(null, t).blink;
+    blink.push(b);
+    if (b === 0 && open === null) open = canvas.toDataURL();
+    if (b > 0.9 && shut === null) shut = canvas.toDataURL();
+  }
+  canvas.remove();
+  return { blink, differ: open !== null && shut !== null && open !== shut };
+}"""
+
+
+def test_eyes_blink_at_random_natural_intervals(server, browser):
+    page = open_page(browser, server)
+    got = page.evaluate(BLINKS)
+    b = got["blink"]
+    assert min(b) == 0 and max(b) > 0.9 and all(0 <= v <= 1 for v in b)
+    shut = [i for i in range(1, len(b)) if b[i] > 0.5 >= b[i - 1]]   # frames a blink shuts
+    assert 6 <= len(shut) <= 30, len(shut)   # people blink every 2-8 s at rest
+    gaps_s = [(j - i) / 60 for i, j in zip(shut, shut[1:])]
+    assert all(1.5 <= g <= 8.5 for g in gaps_s), gaps_s
+    assert len({round(g, 1) for g in gaps_s}) > len(gaps_s) // 2   # not a fixed period
+    lengths = []                                                   # each one is brief
+    for i in shut:
+        k = i
+        while k < len(b) and b[k] > 0:
+            k += 1
+        lengths.append((k - i) / 60)
+    assert all(length < 0.3 for length in lengths), lengths
+    assert got["differ"], "the drawn eyes look the same shut as open"
+    assert not page.errors, page.errors
+    page.close()
