@@ -161,7 +161,10 @@ BLINKS = """async () => {
   canvas.style.cssText = 'width:300px;height:300px;position:fixed;left:0;top:0';
   document.body.appendChild(canvas);
   let seed = 12345;
-  const random = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
+  const random = () => {
+    seed = (seed * 1103515245 + 12345) % 2147483648;
+    return seed / 2147483648;
+  };
   const face = await createFace(canvas, { look: 'shaded', random });
   const blink = [];
   let open = null, shut = null;
@@ -183,7 +186,7 @@ def test_eyes_blink_at_random_natural_intervals(server, browser):
     assert min(b) == 0 and max(b) > 0.9 and all(0 <= v <= 1 for v in b)
     shut = [i for i in range(1, len(b)) if b[i] > 0.5 >= b[i - 1]]   # frames a blink shuts
     assert 6 <= len(shut) <= 30, len(shut)   # people blink every 2-8 s at rest
-    gaps_s = [(j - i) / 60 for i, j in zip(shut, shut[1:])]
+    gaps_s = [(j - i) / 60 for i, j in zip(shut, shut[1:], strict=False)]
     assert all(1.5 <= g <= 8.5 for g in gaps_s), gaps_s
     assert len({round(g, 1) for g in gaps_s}) > len(gaps_s) // 2   # not a fixed period
     lengths = []                                                   # each one is brief

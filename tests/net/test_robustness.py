@@ -32,7 +32,8 @@ _messages = st.one_of(
                                                     "stop", "ping", "pong", "hello", ""])},
                           optional={"text": _scalars, "voice": _scalars, "rate_wpm": _scalars,
                                     "pitch_hz": _scalars, "mouth_model": _scalars,
-                                    "t_client": _scalars, "extra": _scalars}),
+                                    "t_client": _scalars, "extra": _scalars,
+                                    "spring_params": _json}),
 )
 
 
@@ -67,6 +68,38 @@ def test_fuzz_speak_endpoint_never_500(client, body):
     raw = json.dumps(body, allow_nan=True)  # NaN/Infinity tokens too, as a hostile client may
     r = client.post("/speak", content=raw, headers={"content-type": "application/json"})
     assert r.status_code < 500
+    if r.status_code >= 400:
+        assert "error" in r.json() or "detail" in r.json()
+
+
+def _get_routes():
+    """Every GET route the app has, schema or not: a new route is fuzzed without edits."""
+    from fastapi.routing import APIRoute
+    app = create_app(Settings())
+    return sorted(r.path for r in app.routes if isinstance(r, APIRoute) and "GET" in r.methods)
+
+
+_segment = st.one_of(st.text(max_size=30), st.sampled_from(
+    ["..", "../..", "%2e%2e", "0", "-1", "99999999999999999999", "app.js", "lipclock.js",
+     "morphs.tsv", "dynamics.toml", "%00", "a" * 300]))
+
+
+def test_fuzz_covers_every_get_route():
+    assert {"/", "/voices", "/mesh", "/healthz", "/metrics", "/utterances/{uid}.wav",
+            "/client/{name:path}"} <= set(_get_routes())
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                   HealthCheck.function_scoped_fixture])
+@given(st.sampled_from(_get_routes()), _segment,
+       st.dictionaries(st.text(min_size=1, max_size=8), st.text(max_size=20), max_size=3))
+def test_fuzz_every_get_endpoint_never_500(client, route, segment, query):
+    from urllib.parse import quote
+    path = route
+    for param in ("{uid}", "{name:path}", "{name}"):
+        path = path.replace(param, quote(segment, safe="/%"))
+    r = client.get(path, params=query)
+    assert r.status_code < 500, (path, r.status_code)
     if r.status_code >= 400:
         assert "error" in r.json() or "detail" in r.json()
 

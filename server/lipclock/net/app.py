@@ -200,8 +200,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         return JSONResponse(prep.marks())
 
     def client_file(name: str) -> Response:
-        path = (CLIENT_DIR / name).resolve()
-        if CLIENT_DIR.resolve() not in path.parents or not path.is_file():
+        try:  # a NUL or an over-long name is just a file that isn't there
+            path = (CLIENT_DIR / name).resolve()
+            found = CLIENT_DIR.resolve() in path.parents and path.is_file()
+        except (ValueError, OSError):
+            found = False
+        if not found:
             return _error(404, "not_found", f"client file {name!r} not found")
         return FileResponse(path)
 
