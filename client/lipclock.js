@@ -6,6 +6,33 @@
 export const PROTOCOL_VERSION = 1;
 const HEADER_BYTES = 16;
 
+// What each server message must carry before the client acts on it (docs/protocol.md):
+// a missing or mistyped field is one warning, never a half-built utterance.
+const isInt = (v) => Number.isInteger(v) && v >= 0;
+const isPos = (v) => typeof v === "number" && v > 0 && Number.isFinite(v);
+const isNum = (v) => typeof v === "number" && Number.isFinite(v);
+const isArr = Array.isArray;
+const REQUIRED = {
+  hello: { protocol_version: isInt, sample_rate: isPos },
+  clock: { device_sample: isNum, server_time_s: isNum },
+  start: { utterance_id: isInt, sample_rate: isPos, num_samples: isInt, mouth_rate_hz: isPos,
+           words: isArr, phones: isArr, visemes: isArr, mouth_nodes: isArr },
+  mouth: { utterance_id: isInt, first_frame: isInt, frames: isArr, lip_gap: isArr },
+  end: { utterance_id: isInt, end_sample: isInt },
+  pong: { t_client: isNum, server_time_s: isNum },
+};
+
+function malformed(m) {
+  if (m === null || typeof m !== "object" || Array.isArray(m)) return "not a JSON object";
+  if (typeof m.type !== "string") return "no message type";
+  const need = REQUIRED[m.type] || {};
+  for (const [field, ok] of Object.entries(need)) {
+    if (!ok(m[field])) return `${m.type}.${field} is missing or of the wrong type`;
+  }
+  if (m.type === "mouth" && m.frames.length !== m.lip_gap.length) return "mouth frames and lip_gap differ in length";
+  return null;
+}
+
 export class LipclockClient extends EventTarget {
   constructor({ url, channel = "default", key = null, jitterBufferS = 0.12 } = {}) {
     super();
@@ -69,6 +96,8 @@ export class LipclockClient extends EventTarget {
   }
 
   _onJson(m) {
+    const bad = malformed(m);
+    if (bad) { console.warn(`lipclock: ignoring a malformed message: ${bad}`); return; }
     switch (m.type) {
       case "hello":
         if (m.protocol_version !== PROTOCOL_VERSION) {
@@ -139,11 +168,15 @@ export class LipclockClient extends EventTarget {
 
   _onAudio(buf) {
     const u = this.utt;
-    if (this.deviceMode) return;    // the server's device plays it
-    if (!u || !this.ctx || buf.byteLength < HEADER_BYTES) return;
     const dv = new DataView(buf);
-    const magic = String.fromCharCode(dv.getUint8(0), dv.getUint8(1), dv.getUint8(2), dv.getUint8(3));
-    if (magic !== "LCA1") { console.warn("lipclock: bad audio frame"); return; }
+    const magic = buf.byteLength < HEADER_BYTES ? "" :
+      String.fromCharCode(dv.getUint8(0), dv.getUint8(1), dv.getUint8(2), dv.getUint8(3));
+    if (magic !== "LCA1" || (buf.byteLength - HEADER_BYTES) % 2) {
+      console.warn(`lipclock: ignoring a malformed message: bad audio frame (${buf.byteLength} bytes)`);
+      return;
+    }
+    if (this.deviceMode) return;    // the server's device plays it
+    if (!u || !this.ctx) return;
     const id = dv.getUint32(4, true);
     const first = Number(dv.getBigUint64(8, true));
     if (id !== u.id) return;
