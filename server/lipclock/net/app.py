@@ -1,8 +1,8 @@
 """The HTTP/WebSocket server: a thin edge that turns wire messages into core calls.
 
 Routes: POST /speak, GET /voices, /mesh, /healthz, /metrics, /utterances/{id}.wav,
-/utterances/{id}/marks.json, / and /kiosk (the browser client), /tables/... (the viseme
-tables the client reads), WebSocket /ws.
+/utterances/{id}/marks.json, /, /kiosk and /avatar3d (the browser client), /tables/... (the
+viseme tables the client reads), WebSocket /ws.
 Synthesis runs in worker threads so the event loop stays responsive.
 """
 
@@ -214,6 +214,10 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     @app.get("/kiosk", include_in_schema=False)
     async def kiosk() -> Response:
         return client_file("kiosk.html")
+
+    @app.get("/avatar3d", include_in_schema=False)
+    async def avatar3d() -> Response:
+        return client_file("avatar3d.html")
 
     # the viseme tables the browser client reads, checked first: a bad table is the
     # server's fault (500), reported with its file:line
