@@ -89,9 +89,10 @@ def test_a_bad_table_line_names_the_file_and_line(server, browser):
     page.close()
 
 
-# the drawn frame has the jaw well down: keep it on screen for the screenshot
+# the drawn frame has the jaw well down and the lips apart: keep it on screen for the screenshot
 HOLD_OPEN = """() => { const d = window.avatarDebug;
-  if (d.drawn && d.drawn.jawOpen > 0.6) { d.hold = true; d.held = d.weights; return true; }
+  if (d.drawn && d.drawn.jawOpen > 0.6 && d.drawn.mouthClose === 0) {
+    d.hold = true; d.held = d.weights; return true; }
   return false; }"""
 
 # the adaptor over the whole utterance the page received, every 5 ms (frame-rate independent)
@@ -115,7 +116,9 @@ def test_avatar_page_talks_with_the_morphs(server, browser):
     page.screenshot(path=str(FACE_ARTIFACTS / "avatar3d.png"))
     held = page.evaluate("window.avatarDebug.held")   # both sets, of the frame on screen
     page.evaluate("window.avatarDebug.hold = false")
-    assert held["jawOpen"] > 0.6 and held["viseme_sil"] < 1   # mid-speech, mouth open
+    # mid-speech, the jaw down and the lips apart
+    assert held["viseme_sil"] < 1
+    assert held["jawOpen"] > 0.6 and held["mouthClose"] == 0 and held["mouthLowerDownLeft"] > 0.3
     page.wait_for_function("window.lipclockClient.utt && window.lipclockClient.utt.doneFired",
                            timeout=30000)
     page.wait_for_function("window.avatarDebug.weights.viseme_sil === 1")
