@@ -5,17 +5,27 @@ PY := $(VENV)/bin/python
 PIP := $(VENV)/bin/pip
 STAMP := $(VENV)/.installed
 DEB_PACKAGES := sox espeak-ng libespeak-ng1 flite chromium
+# Tools checked by command rather than by package (command:package), so that a Node.js from
+# elsewhere (nodesource, nvm) counts as present: npm installs three.js for the 3-D example.
+DEB_COMMANDS := node:nodejs npm:npm
 HOST ?= 127.0.0.1
 PORT ?= 8000
+# three.js for the 3-D avatar example: pinned in package.json/package-lock.json, installed by
+# npm ci and copied into client/vendor/ (gitignored), where the server serves it at
+# /client/vendor/three.module.js. No CDN at run time.
+THREE := node_modules/three
+VENDOR := client/vendor
 
 .PHONY: setup system-deps run test lint bench clean
 
-setup: system-deps $(STAMP)
+setup: system-deps $(STAMP) $(VENDOR)/three.module.js
 
 # Debian packages the tests and benchmarks use: sox/espeak-ng/flite as peers and
-# audio tools, chromium for the real-browser client tests. Skipped when present.
+# audio tools, chromium for the real-browser client tests, nodejs/npm for three.js.
+# Skipped when present.
 system-deps:
 	@missing=""; for p in $(DEB_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	for cp in $(DEB_COMMANDS); do command -v $${cp%%:*} >/dev/null || missing="$$missing $${cp#*:}"; done; \
 	if [ -n "$$missing" ]; then \
 	  echo "installing Debian packages:$$missing"; \
 	  SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
@@ -27,6 +37,16 @@ $(STAMP): pyproject.toml
 	$(PIP) install -q --upgrade pip
 	$(PIP) install -q -e '.[dev]'
 	touch $(STAMP)
+
+# three.module.js imports its siblings (three.core.js since r170): copy those it names too.
+$(VENDOR)/three.module.js: package.json package-lock.json
+	npm ci --no-audit --no-fund --loglevel=error
+	mkdir -p $(VENDOR)
+	cp $(THREE)/build/three.module.js $(VENDOR)/
+	cp $(THREE)/LICENSE $(VENDOR)/three.LICENSE
+	for f in $$(grep -oE "from '\./[^']+'" $(THREE)/build/three.module.js | sed -E "s|from '\./(.*)'|\1|" | sort -u); do \
+	  cp $(THREE)/build/$$f $(VENDOR)/; done
+	touch $@
 
 run: setup
 	$(VENV)/bin/lipclock serve --host $(HOST) --port $(PORT)
@@ -42,4 +62,4 @@ bench: setup
 	for b in bench/bench_*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) build *.egg-info server/*.egg-info
+	rm -rf $(VENV) build *.egg-info server/*.egg-info node_modules $(VENDOR)

@@ -118,14 +118,18 @@ export class LipclockClient extends EventTarget {
         this._silence("replaced");
         this.utt = { id: m.utterance_id, sr: m.sample_rate, n: m.num_samples, start: m,
                      deviceStart: m.device_start ?? null,
-                     t0: null, sources: [], frames: [], gap: [], rateHz: m.mouth_rate_hz,
+                     t0: null, sources: [], frames: [], gap: [], width: [], jaw: [],
+                     rateHz: m.mouth_rate_hz,
                      wordIdx: 0, ended: false, endSample: m.num_samples };
         this.dispatchEvent(new CustomEvent("utterance-start", { detail: m }));
         break;
       case "mouth": {
         const u = this.utt;
         if (!u || u.id !== m.utterance_id) return;
-        m.frames.forEach((f, i) => { u.frames[m.first_frame + i] = f; u.gap[m.first_frame + i] = m.lip_gap[i]; });
+        m.frames.forEach((f, i) => {
+          const k = m.first_frame + i;
+          u.frames[k] = f; u.gap[k] = m.lip_gap[i]; u.width[k] = m.width[i]; u.jaw[k] = m.jaw[i];
+        });
         break;
       }
       case "end": {
@@ -238,7 +242,7 @@ export class LipclockClient extends EventTarget {
     return s;
   }
 
-  // Mouth state at a sample: interpolated node positions and lip gap.
+  // Mouth state at a sample: interpolated node positions and measures (lip gap, width, jaw; mm).
   mouthAt(sample) {
     const u = this.utt;
     if (!u || sample === null) return null;
@@ -248,8 +252,9 @@ export class LipclockClient extends EventTarget {
     if (!a) return null;
     const f = pos - k;
     const nodes = a.map((p, i) => [p[0] + (b[i][0] - p[0]) * f, p[1] + (b[i][1] - p[1]) * f]);
-    const gap = (u.gap[k] ?? 0) + ((u.gap[k + 1] ?? u.gap[k] ?? 0) - (u.gap[k] ?? 0)) * f;
-    return { nodes, names: u.start.mouth_nodes, lipGap: gap, sample: Math.round(k * u.sr / u.rateHz + f * u.sr / u.rateHz) };
+    const lerp = (v) => (v[k] ?? 0) + ((v[k + 1] ?? v[k] ?? 0) - (v[k] ?? 0)) * f;
+    return { nodes, names: u.start.mouth_nodes, lipGap: lerp(u.gap), width: lerp(u.width),
+             jaw: lerp(u.jaw), sample: Math.round(k * u.sr / u.rateHz + f * u.sr / u.rateHz) };
   }
 
   // Call render({sample, mouth, time}) on every animation frame, for the sample heard at

@@ -1,7 +1,8 @@
 """The HTTP/WebSocket server: a thin edge that turns wire messages into core calls.
 
 Routes: POST /speak, GET /voices, /mesh, /healthz, /metrics, /utterances/{id}.wav,
-/utterances/{id}/marks.json, / and /kiosk (the browser client), WebSocket /ws.
+/utterances/{id}/marks.json, /, /kiosk and /avatar3d (the browser client), /tables/... (the
+viseme tables the client reads), WebSocket /ws.
 Synthesis runs in worker threads so the event loop stays responsive.
 """
 
@@ -25,9 +26,10 @@ from starlette.websockets import WebSocketDisconnect
 import lipclock
 
 from ..config import Settings
-from ..errors import LipclockError
+from ..errors import LipclockError, TableError
 from ..face.mesh import mesh_json
 from ..face.models import MOUTH_MODELS
+from ..face.morphs import morph_table, morph_table_path
 from ..face.spring import spring_params
 from ..speech.system_voice import system_voices
 from ..speech.voices import get_voice, voice_names
@@ -216,6 +218,26 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     @app.get("/kiosk", include_in_schema=False)
     async def kiosk() -> Response:
         return client_file("kiosk.html")
+
+    @app.get("/avatar3d", include_in_schema=False)
+    async def avatar3d() -> Response:
+        return client_file("avatar3d.html")
+
+    # the viseme tables the browser client reads, checked first: a bad table is the
+    # server's fault (500), reported with its file:line
+    client_tables = {"morphs.tsv": (morph_table, morph_table_path)}
+
+    @app.get("/tables/{name}", include_in_schema=False)
+    async def client_table(name: str) -> Response:
+        if name not in client_tables:
+            return _error(404, "not_found", f"table {name!r} is not served")
+        check, path = client_tables[name]
+        try:
+            check()
+        except TableError as exc:
+            log.error("%s", exc.reason)
+            return _error(500, exc.code, exc.reason)
+        return FileResponse(path(), media_type="text/tab-separated-values; charset=utf-8")
 
     @app.get("/client/{name:path}", include_in_schema=False)
     async def client_static(name: str) -> Response:
