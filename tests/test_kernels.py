@@ -374,3 +374,39 @@ def test_render_rejects_bad_buffers() -> None:
     with pytest.raises((TypeError, ValueError, BufferError)):  # read-only output
         out.flags.writeable = False
         klatt._render(r.frames, 16000, 0, 10, r.state, r.voice, out)
+
+
+def test_kernels_reject_wrong_dtypes_and_sizes() -> None:
+    """The glue checks item types itself: a wrong dtype is a TypeError, not reinterpreted bytes."""
+    r = klatt.KlattRenderer(klatt_frames(np.random.default_rng(0), 4), 16000,
+                            get_voice("adult-low"))
+    out = np.empty(10)
+    with pytest.raises(TypeError, match="frames"):
+        _kernels.klatt_render(r.frames.astype(np.float32), 28, 16000, 0, 10, r.state, r.voice,
+                              out)
+    with pytest.raises(TypeError, match="state"):
+        _kernels.klatt_render(r.frames, 28, 16000, 0, 10, r.state.view(np.int64), r.voice, out)
+    with pytest.raises(ValueError, match="frames"):  # n_par * 8 would wrap around to 224
+        _kernels.klatt_render(np.zeros(56), 2**61 + 28, 16000, 0, 10, r.state, r.voice, out)
+    with pytest.raises(TypeError, match="w"):
+        _kernels.bigram_speed_limit(bytearray(16), 0.1)
+    with pytest.raises(TypeError, match="nodes"):
+        _kernels.limit_node_speed(np.zeros((3, 2, 2), np.int64), 2, 1.0)
+    with pytest.raises(ValueError, match="nodes"):  # 16 * 2**60 wraps to 0: was a SIGFPE
+        _kernels.limit_node_speed(np.zeros(4), 2**60, 1.0)
+    curves = random_curves(np.random.default_rng(7), 2, 2, 3, 3)
+    fs, bounds, w = np.arange(10.0), np.array([0.0, 5.0, 10.0]), np.zeros((3, 10))
+    with pytest.raises(TypeError, match="ids"):
+        _kernels.bigram_stitch(fs, bounds, np.array([0], np.int32), curves[0], curves[1],
+                               curves[2], curves[3], 2, w)
+    ok = dict(vis_idx=np.zeros(4, np.int64), targets=np.zeros((2, 3, 2)),
+              closure=np.zeros(2, bool), rest=np.zeros((3, 2)), mass=np.ones(3), k=np.ones(3),
+              c=np.ones(3), k_cl=1.0, c_cl=1.0, lips=np.zeros(3, bool),
+              edges=np.array([[0, 1]]), k_nb=1.0, lip_pairs=np.array([[1, 2]]), dt=1e-3,
+              frame_pos=np.arange(3.0), out=np.empty((3, 3, 2)))
+    _kernels.spring_integrate(*ok.values())
+    for key, bad in (("closure", np.zeros(2, np.uint8)), ("edges", np.array([[0, 1]], np.int32)),
+                     ("out", np.empty((3, 3, 2), np.float32))):
+        with pytest.raises(TypeError, match=key):
+            _kernels.spring_integrate(*{**ok, key: bad}.values())
+

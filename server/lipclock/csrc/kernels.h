@@ -2,7 +2,7 @@
  *
  * Plain C over caller-owned double/int64/byte arrays: the Python wrappers in
  * speech/klatt.py and the face/ modules check dtypes and shapes, the module glue
- * (module.c) checks buffer sizes and indices, so these loops trust their input.
+ * (module.c) checks item types, buffer sizes and indices, so these loops trust their input.
  * Arithmetic follows the Python reference expressions term by term, in the same
  * order, so results are reproducible; build without -ffast-math and with
  * -ffp-contract=off (no fused multiply-add).

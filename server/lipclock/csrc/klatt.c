@@ -67,11 +67,11 @@ void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t
         if (n == start || n % block == 0) {
             int64_t b0 = n - n % block;
             double pos = (double)b0 * FRAME_RATE_HZ / srf;
-            int64_t k = (int64_t)pos;
-            double frac = pos - (double)k;
-            if (k >= n_frames - 1) {
-                k = n_frames - 2;
-                frac = 1.0;
+            int64_t k = n_frames - 2;
+            double frac = 1.0; /* past the last frame: hold it */
+            if (pos < (double)(n_frames - 1)) { /* compare before casting: no overflow */
+                k = (int64_t)pos;
+                frac = pos - (double)k;
             }
             const double *f0row = frames + k * n_par, *f1row = f0row + n_par;
             for (int j = 0; j < K_N_PARAMS; j++) p[j] = f0row[j] * (1.0 - frac) + f1row[j] * frac;
