@@ -4,7 +4,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 PIP := $(VENV)/bin/pip
 STAMP := $(VENV)/.installed
-DEB_PACKAGES := sox espeak-ng libespeak-ng1 flite chromium
+DEB_PACKAGES := sox espeak-ng libespeak-ng1 flite chromium gcc libc6-dev python3-dev python3-venv
 HOST ?= 127.0.0.1
 PORT ?= 8000
 
@@ -13,7 +13,9 @@ PORT ?= 8000
 setup: system-deps $(STAMP)
 
 # Debian packages the tests and benchmarks use: sox/espeak-ng/flite as peers and
-# audio tools, chromium for the real-browser client tests. Skipped when present.
+# audio tools, chromium for the real-browser client tests; gcc, libc6-dev and
+# python3-dev (Python.h) to compile lipclock._kernels, python3-venv for the venv.
+# Skipped when present.
 system-deps:
 	@missing=""; for p in $(DEB_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
