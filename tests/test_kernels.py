@@ -289,11 +289,11 @@ def render_ref(frames: np.ndarray, sr: int, n_samples: int, voice: np.ndarray,
         nlp1 = r1 + seed / 1073741823.5 - 1.0 + 0.75 * nlp1
         mod = 1.0 if (av_latch == 0.0 or phase <= te) else 0.5
         xin = tilt_y + (ah + breath * av_latch * 0.12) * nlp1 * mod * 0.012
-        y = (xin - casc[0][1] * mem[0] - casc[0][2] * mem[1]) * inv_a0 if inv_a0 != 0.0 else xin
+        y = (xin - (casc[0][1] * mem[0] + casc[0][2] * mem[1])) * inv_a0 if inv_a0 != 0.0 else xin
         mem[0:2] = [xin, mem[0]]
         for j in range(1, 7):
             a, b, c = casc[j]
-            y = a * y + b * mem[2 * j] + c * mem[2 * j + 1]
+            y = a * y + (b * mem[2 * j] + c * mem[2 * j + 1])
             mem[2 * j:2 * j + 2] = [y, mem[2 * j]]
         total = y
         if quiet < 10:
@@ -302,7 +302,7 @@ def render_ref(frames: np.ndarray, sr: int, n_samples: int, voice: np.ndarray,
             for j in range(5):
                 a, b, c = par[j]
                 m = 2 * (7 + j)
-                yp = a * fric + b * mem[m] + c * mem[m + 1]
+                yp = (a * fric + c * mem[m + 1]) + b * mem[m]
                 mem[m:m + 2] = [yp, mem[m]]
                 total_par += sign * par_amp[j] * yp
                 sign = -sign

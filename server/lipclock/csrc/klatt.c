@@ -45,6 +45,26 @@ static void resonator(double f, double bw, double sr, int peak, double *out) {
     out[2] = c;
 }
 
+/* resonator() with a one-entry memory per slot: consecutive blocks often carry the same
+ * frequency and bandwidth (steady segments, bypassed nasals), and the same inputs give the
+ * same coefficients, so skipping the exp/cos/sqrt is exact. */
+typedef struct { double f, bw; } res_key;
+
+static void resonator_memo(double f, double bw, double sr, int peak, double *out, res_key *key) {
+    if (f == key->f && bw == key->bw) return;
+    key->f = f;
+    key->bw = bw;
+    resonator(f, bw, sr, peak, out);
+}
+
+static double db_to_amp_memo(double x, double *last_x, double *last_amp) {
+    if (x != *last_x) {
+        *last_x = x;
+        *last_amp = db_to_amp(x);
+    }
+    return *last_amp;
+}
+
 void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t sr,
                   int64_t start, int64_t end, double *state, const double *voice,
                   double *out) {
@@ -62,10 +82,17 @@ void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t
     int64_t seed = (int64_t)state[KS_SEED];
     int64_t quiet_blocks = (int64_t)state[KS_QUIET];
     double av = 0.0, ah = 0.0, af = 0.0, tilt_a = 0.0, inv_a0 = 1.0;
+    res_key keys[K_N_CASC + K_N_PAR];
+    for (int j = 0; j < K_N_CASC + K_N_PAR; j++) keys[j].f = keys[j].bw = NAN; /* never equal */
+    double amp_x[9], amp_v[9] = {0.0}, last_tilt_db = NAN, g = 1.0;
+    for (int j = 0; j < 9; j++) amp_x[j] = NAN;
 
+    int64_t next_block = start - start % block; /* the next absolute block boundary */
     for (int64_t n = start; n < end; n++) {
-        if (n == start || n % block == 0) {
+        const int at_boundary = n == next_block;
+        if (n == start || at_boundary) {
             int64_t b0 = n - n % block;
+            next_block = b0 + block;
             double pos = (double)b0 * FRAME_RATE_HZ / srf;
             int64_t k = n_frames - 2;
             double frac = 1.0; /* past the last frame: hold it */
@@ -75,25 +102,30 @@ void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t
             }
             const double *f0row = frames + k * n_par, *f1row = f0row + n_par;
             for (int j = 0; j < K_N_PARAMS; j++) p[j] = f0row[j] * (1.0 - frac) + f1row[j] * frac;
-            resonator(p[18], p[19], srf, 0, coef + 0); /* FNZ (used inverted) */
+            resonator_memo(p[18], p[19], srf, 0, coef + 0, keys + 0); /* FNZ (used inverted) */
             inv_a0 = coef[0] != 0.0 ? 1.0 / coef[0] : 0.0;
-            resonator(p[16], p[17], srf, 0, coef + 3); /* FNP */
+            resonator_memo(p[16], p[17], srf, 0, coef + 3, keys + 1); /* FNP */
             for (int j = 0; j < 5; j++) {
                 int fi = 4 - j; /* F5 first */
-                resonator(p[4 + fi] * fscale, p[10 + fi] * fscale, srf, 0, coef + 6 + 3 * j);
+                resonator_memo(p[4 + fi] * fscale, p[10 + fi] * fscale, srf, 0, coef + 6 + 3 * j,
+                               keys + 2 + j);
             }
-            av = db_to_amp(p[1]);
-            ah = db_to_amp(p[2]);
-            af = db_to_amp(p[3]);
+            av = db_to_amp_memo(p[1], amp_x + 0, amp_v + 0);
+            ah = db_to_amp_memo(p[2], amp_x + 1, amp_v + 1);
+            af = db_to_amp_memo(p[3], amp_x + 2, amp_v + 2);
             if (af > 0.0)
                 quiet_blocks = 0;
-            else if (n % block == 0)
+            else if (at_boundary)
                 quiet_blocks += 1;
-            for (int j = 0; j < 6; j++) par_amp[j] = db_to_amp(p[20 + j]);
+            for (int j = 0; j < 6; j++) par_amp[j] = db_to_amp_memo(p[20 + j], amp_x + 3 + j, amp_v + 3 + j);
             if (quiet_blocks < QUIET_BLOCKS || n == start)
                 for (int j = 0; j < K_N_PAR; j++) /* parallel F2..F6 */
-                    resonator(p[5 + j] * fscale, p[11 + j] * fscale, srf, 1, coef + 21 + 3 * j);
-            double g = pow(10.0, -p[27] / 20.0);
+                    resonator_memo(p[5 + j] * fscale, p[11 + j] * fscale, srf, 1,
+                                   coef + 21 + 3 * j, keys + K_N_CASC + j);
+            if (p[27] != last_tilt_db) {
+                last_tilt_db = p[27];
+                g = pow(10.0, -p[27] / 20.0);
+            }
             if (g >= 0.999) {
                 tilt_a = 0.0;
             } else {
@@ -139,14 +171,15 @@ void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t
         double asp = (ah + breath * av_latch * 0.12) * nlp1 * mod * 0.012;
         /* cascade: nasal zero (inverse resonator), nasal pole, F5..F1 */
         double x = tilt_y + asp;
-        double y = inv_a0 != 0.0 ? (x - coef[1] * mem[0] - coef[2] * mem[1]) * inv_a0 : x;
+        double y = inv_a0 != 0.0 ? (x - (coef[1] * mem[0] + coef[2] * mem[1])) * inv_a0 : x;
         mem[1] = mem[0];
         mem[0] = x;
         x = y;
+#pragma GCC unroll 8
         for (int j = 1; j < K_N_CASC; j++) {
             const double *cf = coef + 3 * j;
             double *m = mem + 2 * j;
-            y = cf[0] * x + cf[1] * m[0] + cf[2] * m[1];
+            y = cf[0] * x + (cf[1] * m[0] + cf[2] * m[1]); /* x waits on one mul+add */
             m[1] = m[0];
             m[0] = y;
             x = y;
@@ -157,10 +190,11 @@ void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t
             double fric = af * nlp1 * mod * 0.1;
             double par = par_amp[5] * fric;
             double sign = 1.0;
+#pragma GCC unroll 8
             for (int j = 0; j < K_N_PAR; j++) {
                 const double *cf = coef + 21 + 3 * j;
                 double *m = mem + 2 * (K_N_CASC + j);
-                y = cf[0] * fric + cf[1] * m[0] + cf[2] * m[1];
+                y = (cf[0] * fric + cf[2] * m[1]) + cf[1] * m[0]; /* m[0]: one mul+add */
                 m[1] = m[0];
                 m[0] = y;
                 par += sign * par_amp[j] * y;
