@@ -4,7 +4,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 PIP := $(VENV)/bin/pip
 STAMP := $(VENV)/.installed
-DEB_PACKAGES := sox espeak-ng libespeak-ng1 flite chromium
+DEB_PACKAGES := sox espeak-ng libespeak-ng1 flite chromium gcc libc6-dev python3-dev python3-venv
 # Tools checked by command rather than by package (command:package), so that a Node.js from
 # elsewhere (nodesource, nvm) counts as present: npm installs three.js for the 3-D example.
 DEB_COMMANDS := node:nodejs npm:npm
@@ -21,7 +21,9 @@ VENDOR := client/vendor
 setup: system-deps $(STAMP) $(VENDOR)/three.module.js
 
 # Debian packages the tests and benchmarks use: sox/espeak-ng/flite as peers and
-# audio tools, chromium for the real-browser client tests, nodejs/npm for three.js.
+# audio tools, chromium for the real-browser client tests, nodejs/npm for three.js;
+# gcc, libc6-dev and python3-dev (Python.h) to compile lipclock._kernels, python3-venv
+# for the venv.
 # Skipped when present.
 system-deps:
 	@missing=""; for p in $(DEB_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
@@ -32,7 +34,9 @@ system-deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing; \
 	fi
 
-$(STAMP): pyproject.toml
+# The C kernels (lipclock._kernels) are compiled by the editable install, so editing
+# them reinstalls too.
+$(STAMP): pyproject.toml setup.py $(wildcard server/lipclock/csrc/*.[ch])
 	test -x $(PY) || python3 -m venv $(VENV)
 	$(PIP) install -q --upgrade pip
 	$(PIP) install -q -e '.[dev]'
@@ -62,4 +66,4 @@ bench: setup
 	for b in bench/bench_*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) build *.egg-info server/*.egg-info node_modules $(VENDOR)
+	rm -rf $(VENV) build *.egg-info server/*.egg-info node_modules $(VENDOR) server/lipclock/_kernels.*.so

@@ -143,7 +143,7 @@ def main() -> None:
     print(f"\nCost: {tl.num_samples / tl.sample_rate:.1f} s utterance, 100 Hz, all nodes"
           " (median of 21 runs)")
     for model in MOUTH_MODELS:
-        mouth_for(tl, model)  # warm-up (numba compile / table load)
+        mouth_for(tl, model)  # warm-up (table load)
         times = []
         for _ in range(21):
             t0 = time.perf_counter()

@@ -30,8 +30,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from .. import _kernels
 from ..errors import OutOfRangeError, TableError, UnknownChoiceError
 from ..speech.phoneset import base, phones
 from ..speech.timeline import Timeline
@@ -162,41 +162,22 @@ def _pack(keys: tuple[tuple[str, str], ...], curves: Curves,
     return pose_id, ku, kw, nk
 
 
-@njit(cache=True, nogil=True)
 def _stitch(fs: np.ndarray, bounds: np.ndarray, ids: np.ndarray, pose_id: np.ndarray,
             ku: np.ndarray, kw: np.ndarray, nk: np.ndarray, w: np.ndarray) -> None:
     """Time-warp each phone pair's curves onto its frames and stitch by maximum (in place).
 
     Pair i spans phones i and i+1: bounds[i]..bounds[i+2]; the left phone maps to
-    u in [0, 0.5), the right one to [0.5, 1].
+    u in [0, 0.5), the right one to [0.5, 1]. ``w`` is (n_poses, len(fs)) float64,
+    C-contiguous; the packed curves come from ``_pack``. The loop is C (csrc/face.c).
     """
-    k0 = 0
-    for i in range(ids.shape[0]):
-        a0, b0, b1 = bounds[i], bounds[i + 1], bounds[i + 2]
-        while k0 < fs.shape[0] and fs[k0] < a0:
-            k0 += 1
-        k = k0
-        while k < fs.shape[0] and fs[k] < b1:
-            t = fs[k]
-            if t < b0:
-                u = 0.5 * (t - a0) / max(b0 - a0, 1.0)
-            else:
-                u = 0.5 + 0.5 * (t - b0) / max(b1 - b0, 1.0)
-            for j in range(pose_id.shape[1]):
-                p = pose_id[ids[i], j]
-                if p < 0:
-                    continue
-                n = nk[ids[i], j]
-                m = 1
-                while m < n - 1 and ku[ids[i], j, m] < u:
-                    m += 1
-                u0, u1 = ku[ids[i], j, m - 1], ku[ids[i], j, m]
-                w0, w1 = kw[ids[i], j, m - 1], kw[ids[i], j, m]
-                x = min(max((u - u0) / (u1 - u0), 0.0), 1.0)
-                v = w0 + (w1 - w0) * x
-                if v > w[p, k]:
-                    w[p, k] = v
-            k += 1
+    f64, i64 = np.float64, np.int64
+    if w.dtype != f64 or not w.flags.c_contiguous:
+        raise ValueError("w must be a C-contiguous float64 array")
+    _kernels.bigram_stitch(
+        np.ascontiguousarray(fs, f64), np.ascontiguousarray(bounds, f64),
+        np.ascontiguousarray(ids, i64), np.ascontiguousarray(pose_id, i64),
+        np.ascontiguousarray(ku, f64), np.ascontiguousarray(kw, f64),
+        np.ascontiguousarray(nk, i64), pose_id.shape[1], w)
 
 
 def _closing(w: np.ndarray, width: int) -> np.ndarray:
@@ -209,14 +190,10 @@ def _closing(w: np.ndarray, width: int) -> np.ndarray:
     return win(np.pad(d, pad, mode="edge"), 2 * pad + 1).min(axis=1)
 
 
-@njit(cache=True, nogil=True)
 def _speed_limit(w: np.ndarray, step: float) -> np.ndarray:
     """Slope-limited dilation: every weight >= neighbour - step, both directions."""
-    w = w.copy()
-    for k in range(1, len(w)):
-        w[k] = max(w[k], w[k - 1] - step)
-    for k in range(len(w) - 2, -1, -1):
-        w[k] = max(w[k], w[k + 1] - step)
+    w = np.array(w, dtype=np.float64)  # a fresh C-contiguous copy, limited in place
+    _kernels.bigram_speed_limit(w, float(step))
     return w
 
 
@@ -247,11 +224,11 @@ def bigram_measures(timeline: Timeline, frame_samples: np.ndarray,
     ph = timeline.phones
     keys = list(curves)
     key_id = {k: i for i, k in enumerate(keys)}
-    packed = _pack(tuple(keys), curves, tuple(pose_names))
+    pose_id, ku, kw, nk = _pack(tuple(keys), curves, tuple(pose_names))
     cls = [cls_of[base(p.phone)] for p in ph]
     ids = np.array([key_id[(a, b)] for a, b in zip(cls, cls[1:], strict=False)], np.int64)
     bounds = np.array([p.start for p in ph] + [ph[-1].end], dtype=np.float64)
-    _stitch(fs, bounds, ids, *packed, w)
+    _stitch(fs, bounds, ids, pose_id, ku, kw, nk, w)
     if len(ph) == 1:
         w[pose_index[classes[cls_of[base(ph[0].phone)]][0]]] = 1.0
     frame_s = float(np.median(np.diff(fs))) / timeline.sample_rate if len(fs) > 1 else 0.01

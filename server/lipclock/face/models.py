@@ -14,8 +14,8 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from .. import _kernels
 from ..errors import OutOfRangeError, UnknownChoiceError
 from ..speech.timeline import Timeline
 from ..tables import package_file
@@ -42,19 +42,15 @@ def measures_from_nodes(nodes: np.ndarray) -> dict[str, np.ndarray]:
 MAX_NODE_SPEED_MM_S = 500.0  # lips at face scale: 0.5 m/s (docs/mouth.md)
 
 
-@njit(cache=True, nogil=True)
 def limit_node_speed(nodes: np.ndarray, max_step_mm: float) -> np.ndarray:
-    """No node moves more than ``max_step_mm`` between frames: it follows late instead."""
-    out = nodes.copy()
-    for k in range(1, out.shape[0]):
-        for i in range(out.shape[1]):
-            dx = out[k, i, 0] - out[k - 1, i, 0]
-            dy = out[k, i, 1] - out[k - 1, i, 1]
-            d = math.sqrt(dx * dx + dy * dy)
-            if d > max_step_mm:
-                f = max_step_mm / d
-                out[k, i, 0] = out[k - 1, i, 0] + dx * f
-                out[k, i, 1] = out[k - 1, i, 1] + dy * f
+    """No node moves more than ``max_step_mm`` between frames: it follows late instead.
+
+    ``nodes`` is (n_frames, N, 2) mm; returns a new float64 array. The loop is C."""
+    if nodes.ndim != 3 or nodes.shape[2] != 2:
+        raise ValueError(f"nodes must be (n_frames, N, 2), got {nodes.shape}")
+    out = np.array(nodes, dtype=np.float64)  # a fresh C-contiguous copy, limited in place
+    if out.size:
+        _kernels.limit_node_speed(out, out.shape[1], float(max_step_mm))
     return out
 
 

@@ -22,8 +22,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from .. import _kernels
 from ..errors import LipclockError, OutOfRangeError, TableError, UnknownChoiceError
 from ..speech.timeline import Timeline
 from ..tables import finite_float, line_of, load_toml, package_file
@@ -192,67 +192,25 @@ def spring_nodes(timeline: Timeline, rate_hz: float, d: Dynamics) -> np.ndarray:
                       frame_pos)
 
 
-@njit(cache=True, nogil=True)
-def _integrate(vis_idx, targets, closure, rest, mass, k, c, k_cl, c_cl, lips, edges, k_nb,
-               lip_pairs, dt, frame_pos):  # type: ignore[no-untyped-def]
+def _integrate(vis_idx: np.ndarray, targets: np.ndarray, closure: np.ndarray,
+               rest: np.ndarray, mass: np.ndarray, k: np.ndarray, c: np.ndarray, k_cl: float,
+               c_cl: float, lips: np.ndarray, edges: np.ndarray, k_nb: float,
+               lip_pairs: np.ndarray, dt: float, frame_pos: np.ndarray) -> np.ndarray:
     """Step the mesh; record node positions at the first step at or after each frame
     (``frame_pos`` in steps; at most half a step, 1 ms, from the frame's sample).
 
-    Arrays are flattened to x0, y0, x1, y1, ... so the per-node loops are simple."""
-    n_steps = vis_idx.shape[0]
-    n = rest.shape[0]
-    m2 = 2 * n
-    flat_t = targets.reshape(targets.shape[0], m2)
-    x = rest.reshape(m2).copy()
-    v = np.zeros(m2)
-    f = np.empty(m2)
-    inv_m = np.empty(m2)
-    k_open, c_open = np.empty(m2), np.empty(m2)
-    k_close, c_close = np.empty(m2), np.empty(m2)
-    for i in range(n):
-        for a in range(2):
-            j = 2 * i + a
-            inv_m[j] = dt / mass[i]
-            k_open[j], c_open[j] = k[i], c[i]
-            k_close[j] = k_cl if lips[i] else k[i]
-            c_close[j] = c_cl if lips[i] else c[i]
-    out = np.empty((frame_pos.shape[0], n, 2))
-    fi = 0
-    n_e = edges.shape[0]
-    for s in range(n_steps):
-        vi = vis_idx[s]
-        if closure[vi]:
-            ks, cs = k_close, c_close
-        else:
-            ks, cs = k_open, c_open
-        for j in range(m2):
-            f[j] = ks[j] * (flat_t[vi, j] - x[j]) - cs[j] * v[j]
-        for e in range(n_e):
-            i2, j2 = 2 * edges[e, 0], 2 * edges[e, 1]
-            for a in range(2):
-                stretch = (x[j2 + a] - x[i2 + a]) - (flat_t[vi, j2 + a] - flat_t[vi, i2 + a])
-                f[i2 + a] += k_nb * stretch
-                f[j2 + a] -= k_nb * stretch
-        for j in range(m2):
-            v[j] += f[j] * inv_m[j]
-            x[j] += v[j] * dt
-        for p in range(lip_pairs.shape[0]):  # the inner lips touch; they never cross
-            u, lo = 2 * lip_pairs[p, 0] + 1, 2 * lip_pairs[p, 1] + 1
-            if x[lo] > x[u]:
-                mid = 0.5 * (x[lo] + x[u])
-                x[lo] = mid
-                x[u] = mid
-                vm = 0.5 * (v[lo] + v[u])
-                v[lo] = vm
-                v[u] = vm
-        while fi < frame_pos.shape[0] and frame_pos[fi] <= s + 0.5:
-            for i in range(n):
-                out[fi, i, 0] = x[2 * i]
-                out[fi, i, 1] = x[2 * i + 1]
-            fi += 1
-    while fi < frame_pos.shape[0]:  # frames past the last step hold the final pose
-        for i in range(n):
-            out[fi, i, 0] = x[2 * i]
-            out[fi, i, 1] = x[2 * i + 1]
-        fi += 1
+    Shapes: vis_idx (n_steps,) viseme per step; targets (V, N, 2) mm; closure (V,) bool;
+    rest (N, 2) mm; mass kg, k N/m, c N*s/m (N,); lips (N,) bool; edges (E, 2) and
+    lip_pairs (P, 2, upper then lower) node indices; dt s. Returns (n_frames, N, 2) mm.
+    The loop is C (csrc/face.c)."""
+    f64, i64 = np.float64, np.int64
+    rest = np.ascontiguousarray(rest, f64)
+    out = np.empty((len(frame_pos), rest.shape[0], 2))
+    _kernels.spring_integrate(
+        np.ascontiguousarray(vis_idx, i64), np.ascontiguousarray(targets, f64),
+        np.ascontiguousarray(closure, np.bool_), rest, np.ascontiguousarray(mass, f64),
+        np.ascontiguousarray(k, f64), np.ascontiguousarray(c, f64), float(k_cl), float(c_cl),
+        np.ascontiguousarray(lips, np.bool_), np.ascontiguousarray(edges, i64), float(k_nb),
+        np.ascontiguousarray(lip_pairs, i64), float(dt), np.ascontiguousarray(frame_pos, f64),
+        out)
     return out

@@ -402,7 +402,7 @@ def serve(settings: Settings) -> None:
                         settings.host)
             settings = settings.model_copy(update={"host": "127.0.0.1"})
         log.warning("no API keys configured: the server is open to anyone on this machine")
-    lipclock.synthesize("Ready.", settings=settings)  # load the lexicon, compile numba kernels
+    lipclock.synthesize("Ready.", settings=settings)  # load the lexicon and tables: ready to speak
     # permessage-deflate off: every broadcast would be compressed once per connection,
     # which dominated server CPU with many subscribers (bench_server_fanout.py)
     uvicorn.run(create_app(settings), host=settings.host, port=settings.port,
