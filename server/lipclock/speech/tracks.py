@@ -304,6 +304,8 @@ def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
             # a coda stop (end of its word) is released weakly or not at all
             weaker = _CODA_BURST_DB if c == "stop" and _coda(ph, cls, i) else 0.0
             burst[i, 2:] = [max(0.0, v[name] - weaker) if v[name] else 0.0 for name, _ in _PAR]
+            if c == "stop" and nxt in ("stop", "affricate"):
+                burst[i, 2:] = 0.0  # a stop before another closure is unreleased
             burst[i, 0] = v["AV"]
             if voiced and c == "stop" and i > 0 and cls[i - 1] != "silence":
                 closure[i, 0] = _VOICE_BAR_DB  # voice bar during the closure
