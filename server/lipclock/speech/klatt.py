@@ -37,7 +37,8 @@ LIMIT = 30000.0  # soft limiter knee in int16 units
 _S_PHASE, _S_T0, _S_TE, _S_AVLAT, _S_TILT, _S_NLP1, _S_NLP2, _S_RAD, _S_SEED = range(9)
 # (_S_NLP2 holds the parallel branch's quiet-block counter)
 _S_RES = 9  # resonator memories start here: 2 per section
-_N_CASC = 7  # NZ, NP, F5, F4, F3, F2, F1
+_N_CASC = 8  # NZ, NP, F6, F5, F4, F3, F2, F1
+_P0 = 3 * _N_CASC  # first parallel coefficient
 _N_PAR = 5  # F2..F6 parallel
 STATE_SIZE = _S_RES + 2 * (_N_CASC + _N_PAR) + 2
 
@@ -102,8 +103,8 @@ def _render(frames: np.ndarray, sr: int, start: int, end: int, state: np.ndarray
             _res(p[18], p[19], srf, False, coef, 0)  # FNZ (used inverted)
             inv_a0 = 1.0 / coef[0] if coef[0] != 0.0 else 0.0
             _res(p[16], p[17], srf, False, coef, 3)  # FNP
-            for j in range(5):
-                fi = 4 - j  # F5 first
+            for j in range(6):
+                fi = 5 - j  # F6 first
                 _res(p[4 + fi] * fscale, p[10 + fi] * fscale, srf, False, coef, 6 + 3 * j)
             av = _db(p[1])
             ah = _db(p[2])
@@ -117,7 +118,7 @@ def _render(frames: np.ndarray, sr: int, start: int, end: int, state: np.ndarray
                 par_amp[j] = _db(p[20 + j])
             if quiet_blocks < 10 or n == start:
                 for j in range(5):  # parallel F2..F6
-                    _res(p[5 + j] * fscale, p[11 + j] * fscale, srf, True, coef, 21 + 3 * j)
+                    _res(p[5 + j] * fscale, p[11 + j] * fscale, srf, True, coef, _P0 + 3 * j)
             g = 10.0 ** (-p[27] / 20.0)
             if g >= 0.999:
                 tilt_a = 0.0
@@ -178,7 +179,7 @@ def _render(frames: np.ndarray, sr: int, start: int, end: int, state: np.ndarray
             par = par_amp[5] * fric
             sign = 1.0
             for j in range(_N_PAR):
-                i = 21 + 3 * j
+                i = _P0 + 3 * j
                 m = 2 * (_N_CASC + j)
                 y = coef[i] * fric + coef[i + 1] * mem[m] + coef[i + 2] * mem[m + 1]
                 mem[m + 1] = mem[m]
