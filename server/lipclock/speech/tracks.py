@@ -92,7 +92,7 @@ _DEFAULTS = {kp.F4: 3300.0, kp.F5: 3750.0, kp.F6: 4900.0, kp.B4: 250.0, kp.B5: 2
              kp.B6: 1000.0, kp.FNP: 270.0, kp.BNP: 100.0, kp.FNZ: 270.0, kp.BNZ: 100.0}
 # Release burst length by place: labial bursts are brief, velar ones long and
 # often double (Fant 1973; Stevens 1998, ch. 7).
-_BURST_S = {"P": 0.006, "B": 0.005, "T": 0.012, "D": 0.010, "K": 0.028, "G": 0.022}
+_BURST_S = {"P": 0.006, "B": 0.005, "T": 0.012, "D": 0.010, "K": 0.020, "G": 0.016}
 # /s z/ noise peaks above the default F6 (4.9 kHz): move the F6 pole up for them.
 _HIGH_F6_HZ = {"S": 6000.0, "Z": 6000.0}
 _SONORANT = {"vowel", "diphthong", "liquid", "glide", "nasal"}
@@ -329,7 +329,7 @@ def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
         glottal[i] = (c in ("vowel", "diphthong") and p.word >= 0 and i > 0
                       and ph[i - 1].word != p.word
                       and cls[i - 1] in ("vowel", "diphthong", "silence"))
-    bl = np.minimum(burst_s[pidx], 0.5 * dur)
+    bl = np.minimum(burst_s[pidx], np.where(burst_s[pidx] >= 0.5, 0.65, 0.5) * dur)
     in_burst = (burst_s[pidx] > 0) & (t >= dur - bl)
     vals = np.where(in_burst[:, None], burst[pidx], closure[pidx])
     into = np.clip((t - (dur - bl)) / np.maximum(bl, 1e-3), 0.0, 1.0)
