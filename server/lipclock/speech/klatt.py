@@ -4,7 +4,7 @@ Signal path, per sample::
 
     KLGLOTT88 flow (OQ, F0 + flutter) -> tilt low-pass ─┐
     aspiration noise (AH, + breathiness) ───────────────┴─> nasal zero -> nasal pole
-        -> F5 -> F4 -> F3 -> F2 -> F1   (cascade, for voiced sounds)
+        -> F6 -> F5 -> F4 -> F3 -> F2 -> F1   (cascade, for voiced sounds)
     frication noise (AF) -> F2..F6 with A2..A6, + bypass AB   (parallel, alternating signs)
     (cascade + parallel) -> first difference (radiation) -> gain -> soft limit -> int16
 
