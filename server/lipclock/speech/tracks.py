@@ -161,7 +161,7 @@ def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
     t = (fs - p_start[pidx]) / sr
     dur = np.maximum((p_end - p_start) / sr, 1e-3)[pidx]
     _formants(out, t, dur, pidx, np.array(starts), np.array(ends), np.array(bounds), cls)
-    # The synthesizer scales F1..F5 by the voice's tract length but not the nasal
+    # The synthesizer scales F1..F6 by the voice's tract length but not the nasal
     # pair. The murmur's zero exists to cancel F1 (Klatt 1980), so where it is in
     # use (not parked on the pole) it must move with the scaled F1.
     nz = out[:, kp.FNZ]
