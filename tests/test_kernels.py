@@ -235,7 +235,8 @@ def render_ref(frames: np.ndarray, sr: int, n_samples: int, voice: np.ndarray,
     block = max(8, sr // 500)
     phase, t0, te, av_latch, tilt_y, nlp1, quiet, rad_prev, seed = state0[:9]
     quiet, seed = int(quiet), int(seed)
-    mem = [0.0] * 24
+    n_casc = 8  # NZ, NP, F6..F1
+    mem = [0.0] * (2 * (n_casc + 5))
     casc: list[list[float]] = []
     par: list[list[float]] = []
     p: list[float] = []
@@ -255,7 +256,7 @@ def render_ref(frames: np.ndarray, sr: int, n_samples: int, voice: np.ndarray,
             inv_a0 = 1.0 / nz[0] if nz[0] != 0.0 else 0.0
             casc = [nz, res_ref(p[kp.FNP], p[kp.BNP], sr, False)]
             casc += [res_ref(p[kp.F1 + fi] * fscale, p[kp.B1 + fi] * fscale, sr, False)
-                     for fi in (4, 3, 2, 1, 0)]
+                     for fi in (5, 4, 3, 2, 1, 0)]
             av, ah, af = db_ref(p[kp.AV]), db_ref(p[kp.AH]), db_ref(p[kp.AF])
             quiet = 0 if af > 0.0 else quiet + 1
             par_amp = [db_ref(p[kp.A2 + j]) for j in range(6)]
@@ -291,7 +292,7 @@ def render_ref(frames: np.ndarray, sr: int, n_samples: int, voice: np.ndarray,
         xin = tilt_y + (ah + breath * av_latch * 0.12) * nlp1 * mod * 0.012
         y = (xin - (casc[0][1] * mem[0] + casc[0][2] * mem[1])) * inv_a0 if inv_a0 != 0.0 else xin
         mem[0:2] = [xin, mem[0]]
-        for j in range(1, 7):
+        for j in range(1, n_casc):
             a, b, c = casc[j]
             y = a * y + (b * mem[2 * j] + c * mem[2 * j + 1])
             mem[2 * j:2 * j + 2] = [y, mem[2 * j]]
@@ -301,7 +302,7 @@ def render_ref(frames: np.ndarray, sr: int, n_samples: int, voice: np.ndarray,
             total_par, sign = par_amp[5] * fric, 1.0
             for j in range(5):
                 a, b, c = par[j]
-                m = 2 * (7 + j)
+                m = 2 * (n_casc + j)
                 yp = (a * fric + c * mem[m + 1]) + b * mem[m]
                 mem[m:m + 2] = [yp, mem[m]]
                 total_par += sign * par_amp[j] * yp

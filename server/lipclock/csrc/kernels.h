@@ -17,7 +17,8 @@ enum {
     KS_PHASE, KS_T0, KS_TE, KS_AVLAT, KS_TILT, KS_NLP1, KS_QUIET, KS_RAD, KS_SEED,
     KS_RES /* resonator memories: 2 per section */
 };
-#define K_N_CASC 7 /* NZ, NP, F5, F4, F3, F2, F1 */
+#define K_N_CASC 8 /* NZ, NP, F6, F5, F4, F3, F2, F1 */
+#define K_P0 (3 * K_N_CASC) /* first parallel coefficient */
 #define K_N_PAR 5  /* parallel F2..F6 */
 #define K_N_MEM (2 * (K_N_CASC + K_N_PAR))
 #define K_STATE_SIZE (KS_RES + K_N_MEM + 2)

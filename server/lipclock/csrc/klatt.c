@@ -105,8 +105,8 @@ void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t
             resonator_memo(p[18], p[19], srf, 0, coef + 0, keys + 0); /* FNZ (used inverted) */
             inv_a0 = coef[0] != 0.0 ? 1.0 / coef[0] : 0.0;
             resonator_memo(p[16], p[17], srf, 0, coef + 3, keys + 1); /* FNP */
-            for (int j = 0; j < 5; j++) {
-                int fi = 4 - j; /* F5 first */
+            for (int j = 0; j < 6; j++) {
+                int fi = 5 - j; /* F6 first */
                 resonator_memo(p[4 + fi] * fscale, p[10 + fi] * fscale, srf, 0, coef + 6 + 3 * j,
                                keys + 2 + j);
             }
@@ -121,7 +121,7 @@ void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t
             if (quiet_blocks < QUIET_BLOCKS || n == start)
                 for (int j = 0; j < K_N_PAR; j++) /* parallel F2..F6 */
                     resonator_memo(p[5 + j] * fscale, p[11 + j] * fscale, srf, 1,
-                                   coef + 21 + 3 * j, keys + K_N_CASC + j);
+                                   coef + K_P0 + 3 * j, keys + K_N_CASC + j);
             if (p[27] != last_tilt_db) {
                 last_tilt_db = p[27];
                 g = pow(10.0, -p[27] / 20.0);
@@ -169,7 +169,7 @@ void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t
         nlp1 = r1 + (double)seed / 1073741823.5 - 1.0 + 0.75 * nlp1;
         double mod = (av_latch == 0.0 || phase <= te) ? 1.0 : 0.5;
         double asp = (ah + breath * av_latch * 0.12) * nlp1 * mod * 0.012;
-        /* cascade: nasal zero (inverse resonator), nasal pole, F5..F1 */
+        /* cascade: nasal zero (inverse resonator), nasal pole, F6..F1 */
         double x = tilt_y + asp;
         double y = inv_a0 != 0.0 ? (x - (coef[1] * mem[0] + coef[2] * mem[1])) * inv_a0 : x;
         mem[1] = mem[0];
@@ -192,7 +192,7 @@ void klatt_render(const double *frames, int64_t n_frames, int64_t n_par, int64_t
             double sign = 1.0;
 #pragma GCC unroll 8
             for (int j = 0; j < K_N_PAR; j++) {
-                const double *cf = coef + 21 + 3 * j;
+                const double *cf = coef + K_P0 + 3 * j;
                 double *m = mem + 2 * (K_N_CASC + j);
                 y = (cf[0] * fric + cf[2] * m[1]) + cf[1] * m[0]; /* m[0]: one mul+add */
                 m[1] = m[0];

@@ -4,7 +4,7 @@ Signal path, per sample::
 
     KLGLOTT88 flow (OQ, F0 + flutter) -> tilt low-pass ─┐
     aspiration noise (AH, + breathiness) ───────────────┴─> nasal zero -> nasal pole
-        -> F5 -> F4 -> F3 -> F2 -> F1   (cascade, for voiced sounds)
+        -> F6 -> F5 -> F4 -> F3 -> F2 -> F1   (cascade, for voiced sounds)
     frication noise (AF) -> F2..F6 with A2..A6, + bypass AB   (parallel, alternating signs)
     (cascade + parallel) -> first difference (radiation) -> gain -> soft limit -> int16
 
@@ -33,7 +33,8 @@ from .voices import Voice
 _S_PHASE, _S_T0, _S_TE, _S_AVLAT, _S_TILT, _S_NLP1, _S_NLP2, _S_RAD, _S_SEED = range(9)
 # (_S_NLP2 holds the parallel branch's quiet-block counter)
 _S_RES = 9  # resonator memories start here: 2 per section
-_N_CASC = 7  # NZ, NP, F5, F4, F3, F2, F1
+_N_CASC = 8  # NZ, NP, F6, F5, F4, F3, F2, F1
+_P0 = 3 * _N_CASC  # first parallel coefficient
 _N_PAR = 5  # F2..F6 parallel
 STATE_SIZE = _S_RES + 2 * (_N_CASC + _N_PAR) + 2
 

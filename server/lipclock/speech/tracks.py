@@ -7,10 +7,12 @@ scheme used by rule synthesizers):
 * formant transitions: at each consonant-vowel boundary the formants start at a
   locus mix ``k * consonant + (1 - k) * vowel`` and move to the vowel target
   over 40-60 ms; liquids and glides move more slowly, obstruents jump;
-* stops are closure, then a release burst shaped by place (parallel amplitudes),
-  then for voiceless stops before a voiced sound an aspiration interval (VOT
+* stops are closure, then a decaying release burst shaped by place (parallel
+  amplitudes, formants at the locus of the vowel released into), then for
+  onset voiceless stops before a voiced sound an aspiration interval (VOT
   ~55 ms stressed, ~35 ms unstressed) that replaces the start of the next
   phone's voicing; voiced stops keep a weak voice bar and voice at release;
+  coda stops are released weakly and never aspirate into the next word;
 * nasals use the nasal pole/zero pair (murmur) and nasalise the edges of
   neighbouring vowels;
 * fricative noise is shaped by place via A2..A6 and bypass AB;
@@ -90,10 +92,25 @@ _DEFAULTS = {kp.F4: 3300.0, kp.F5: 3750.0, kp.F6: 4900.0, kp.B4: 250.0, kp.B5: 2
              kp.B6: 1000.0, kp.FNP: 270.0, kp.BNP: 100.0, kp.FNZ: 270.0, kp.BNZ: 100.0}
 # Release burst length by place: labial bursts are brief, velar ones long and
 # often double (Fant 1973; Stevens 1998, ch. 7).
-_BURST_S = {"P": 0.006, "B": 0.005, "T": 0.012, "D": 0.010, "K": 0.028, "G": 0.022}
+_BURST_S = {"P": 0.006, "B": 0.005, "T": 0.012, "D": 0.010, "K": 0.020, "G": 0.016}
 # /s z/ noise peaks above the default F6 (4.9 kHz): move the F6 pole up for them.
 _HIGH_F6_HZ = {"S": 6000.0, "Z": 6000.0}
 _SONORANT = {"vowel", "diphthong", "liquid", "glide", "nasal"}
+# The release transient is strongest at the release and dies away over the burst
+# (Stevens 1998 ch. 7): AF falls this many dB from the first to the last burst frame.
+_BURST_DECAY_DB = 12.0
+# Word-final stops are weakly released in connected speech (often unreleased).
+_CODA_BURST_DB = 10.0
+# Voice bar: low-frequency voicing radiated through the walls during a voiced
+# closure, some 25 dB below the vowel.
+_VOICE_BAR_DB = 38.0
+
+
+def _coda(ph: tuple, cls: list[str], i: int) -> bool:
+    """Phone i ends its word's syllable: a pause, another word or a consonant follows."""
+    if i + 1 >= len(ph) or cls[i + 1] == "silence" or ph[i + 1].word != ph[i].word:
+        return True
+    return cls[i + 1] not in ("vowel", "diphthong", "liquid", "glide")
 
 
 def _target_for(phone: str) -> Target:
@@ -144,6 +161,11 @@ def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
     t = (fs - p_start[pidx]) / sr
     dur = np.maximum((p_end - p_start) / sr, 1e-3)[pidx]
     _formants(out, t, dur, pidx, np.array(starts), np.array(ends), np.array(bounds), cls)
+    # The synthesizer scales F1..F6 by the voice's tract length but not the nasal
+    # pair. The murmur's zero exists to cancel F1 (Klatt 1980), so where it is in
+    # use (not parked on the pole) it must move with the scaled F1.
+    nz = out[:, kp.FNZ]
+    out[:, kp.FNZ] = np.where(np.abs(nz - out[:, kp.FNP]) > 1.0, nz * voice.formant_scale, nz)
     _sources(out, fs, t, dur, pidx, cls, tg, ph, sr)
     # smooth voicing onsets/offsets only (never AF/AH/A*: keeps bursts sharp)
     av = out[:, kp.AV].copy()
@@ -228,6 +250,7 @@ def _formants(out: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray,
                               for i, c in enumerate(cls)])
     trans[after_closure] = 0.06  # CV transitions from stops/nasals are the long, audible ones
     is_stop = np.array([c == "stop" for c in cls])
+    released = np.array([i + 1 < n_ph and cls[i + 1] != "silence" for i in range(n_ph)])
     x = np.clip((t / dur - 0.2) / 0.6, 0.0, 1.0)
     glide = (x * x * (3 - 2 * x))[:, None]
     s, e = starts[pidx], ends[pidx]
@@ -239,7 +262,10 @@ def _formants(out: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray,
     lb, rb = bounds[:n_ph][pidx], bounds[1:n_ph + 1][pidx]
     vals = base + (lb - s) * wl + (rb - e) * wr
     stop_f = is_stop[pidx]
-    vals[stop_f] = 0.5 * (lb[stop_f] + rb[stop_f])  # stops hold the locus mix (burst shape)
+    # stops hold the locus of the vowel they release into, so the burst (parallel
+    # F2..F6) is shaped by the CV locus, e.g. velar bursts sit at the F2/F3 pinch
+    # of the following vowel (Stevens 1998 ch. 7); before a pause, the VC locus
+    vals[stop_f] = np.where(released[pidx][stop_f, None], rb[stop_f], lb[stop_f])
     out[:, _FORMANT_COLS] = vals
 
 
@@ -257,6 +283,7 @@ def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
     closure = np.zeros((n_ph, len(_SRC_COLS)))  # AV AH AF A2..A6 AB
     burst = np.zeros((n_ph, len(_SRC_COLS)))
     burst_s = np.zeros(n_ph)
+    burst_decay = np.zeros(n_ph)
     final_decay = np.zeros(n_ph, dtype=bool)
     asp_until = np.full(n_ph, -1, dtype=np.int64)
     glottal = np.zeros(n_ph, dtype=bool)
@@ -279,13 +306,22 @@ def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
         elif c in ("stop", "affricate"):
             voiced = info(p.phone).voiced
             burst_s[i] = _BURST_S.get(p.phone, 0.01) if c == "stop" else 0.5
-            weaker = 0.0 if nxt != "silence" else 8.0
+            # a coda stop (end of its word) is released weakly or not at all
+            weaker = _CODA_BURST_DB if c == "stop" and _coda(ph, cls, i) else 0.0
             burst[i, 2:] = [max(0.0, v[name] - weaker) if v[name] else 0.0 for name, _ in _PAR]
+            if c == "stop" and nxt in ("stop", "affricate"):
+                burst[i, 2:] = 0.0  # a stop before another closure is unreleased
             burst[i, 0] = v["AV"]
             if voiced and c == "stop" and i > 0 and cls[i - 1] != "silence":
-                closure[i, 0] = 38.0  # voice bar during the closure
-        # a voiceless stop before a voiced sound aspirates into the next phone
-        if c == "stop" and not info(p.phone).voiced and nxt in _SONORANT:
+                closure[i, 0] = _VOICE_BAR_DB  # voice bar during the closure
+            if voiced and c == "stop" and nxt in _SONORANT:
+                burst[i, 0] = _VOICE_BAR_DB  # short-lag VOT: voicing runs through the release
+            if c == "stop":
+                burst_decay[i] = _BURST_DECAY_DB
+        # a voiceless stop in a syllable onset aspirates into the next phone;
+        # codas do not (they are unreleased or glottalised), nor do stops after /s/
+        if (c == "stop" and not info(p.phone).voiced and nxt in _SONORANT
+                and not _coda(ph, cls, i) and not (i > 0 and ph[i - 1].base == "S")):
             nxt_ph = ph[i + 1]
             vot_s = 0.055 if nxt_ph.phone[-1:] in ("1", "2") else 0.035
             asp_until[i + 1] = nxt_ph.start + min(int(vot_s * sr), nxt_ph.num_samples // 2)
@@ -293,9 +329,12 @@ def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
         glottal[i] = (c in ("vowel", "diphthong") and p.word >= 0 and i > 0
                       and ph[i - 1].word != p.word
                       and cls[i - 1] in ("vowel", "diphthong", "silence"))
-    bl = np.minimum(burst_s[pidx], 0.5 * dur)
+    bl = np.minimum(burst_s[pidx], np.where(burst_s[pidx] >= 0.5, 0.65, 0.5) * dur)
     in_burst = (burst_s[pidx] > 0) & (t >= dur - bl)
     vals = np.where(in_burst[:, None], burst[pidx], closure[pidx])
+    into = np.clip((t - (dur - bl)) / np.maximum(bl, 1e-3), 0.0, 1.0)
+    decay = np.where(in_burst, burst_decay[pidx] * into, 0.0)
+    vals[:, 2] = np.where(vals[:, 2] > 0, np.maximum(vals[:, 2] - decay, 1.0), 0.0)
     fall = np.clip((t / dur - 0.6) / 0.4, 0.0, 1.0)
     vals[:, 0] -= np.where(final_decay[pidx], 8.0 * fall, 0.0)  # phrase-final decay
     asp = fs < asp_until[pidx]
