@@ -13,5 +13,5 @@ setup(ext_modules=[Extension(
     "lipclock._kernels",
     sources=[f"{CSRC}/module.c", f"{CSRC}/klatt.c", f"{CSRC}/face.c"],
     depends=[f"{CSRC}/kernels.h"],
-    extra_compile_args=["-O2", "-ffp-contract=off", "-fno-math-errno", "-std=gnu11"],
+    extra_compile_args=["-O3", "-ffp-contract=off", "-fno-math-errno", "-std=gnu11"],
 )])

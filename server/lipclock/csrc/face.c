@@ -32,38 +32,48 @@ int spring_integrate(const spring_args *a, double *out) {
             c_close[j] = a->lips[i] ? a->c_cl : a->c[i];
         }
     }
+    /* struct fields in locals and restrict-qualified arrays: the compiler may then keep
+     * them in registers instead of reloading after every store to f, x or v */
+    double *restrict xr = x, *restrict vr = v, *restrict fr = f;
+    const double *restrict im = inv_m;
+    const int64_t *restrict edges = a->edges, *restrict vis_idx = a->vis_idx;
+    const int64_t *restrict pairs = a->lip_pairs;
+    const uint8_t *restrict closure = a->closure;
+    const double *restrict targets = a->targets, *restrict frame_pos = a->frame_pos;
+    const int64_t n_edges = a->n_edges, n_pairs = a->n_pairs, n_frames = a->n_frames;
+    const double k_nb = a->k_nb, dt = a->dt;
     int64_t fi = 0;
     for (int64_t s = 0; s < a->n_steps; s++) {
-        int64_t vi = a->vis_idx[s];
-        const double *t = a->targets + vi * m2;
-        const double *ks = a->closure[vi] ? k_close : k_open;
-        const double *cs = a->closure[vi] ? c_close : c_open;
-        for (int64_t j = 0; j < m2; j++) f[j] = ks[j] * (t[j] - x[j]) - cs[j] * v[j];
-        for (int64_t e = 0; e < a->n_edges; e++) {
-            int64_t i2 = 2 * a->edges[2 * e], j2 = 2 * a->edges[2 * e + 1];
+        int64_t vi = vis_idx[s];
+        const double *restrict t = targets + vi * m2;
+        const double *restrict ks = closure[vi] ? k_close : k_open;
+        const double *restrict cs = closure[vi] ? c_close : c_open;
+        for (int64_t j = 0; j < m2; j++) fr[j] = ks[j] * (t[j] - xr[j]) - cs[j] * vr[j];
+        for (int64_t e = 0; e < n_edges; e++) {
+            int64_t i2 = 2 * edges[2 * e], j2 = 2 * edges[2 * e + 1];
             for (int ax = 0; ax < 2; ax++) {
-                double stretch = (x[j2 + ax] - x[i2 + ax]) - (t[j2 + ax] - t[i2 + ax]);
-                f[i2 + ax] += a->k_nb * stretch;
-                f[j2 + ax] -= a->k_nb * stretch;
+                double stretch = (xr[j2 + ax] - xr[i2 + ax]) - (t[j2 + ax] - t[i2 + ax]);
+                fr[i2 + ax] += k_nb * stretch;
+                fr[j2 + ax] -= k_nb * stretch;
             }
         }
         for (int64_t j = 0; j < m2; j++) {
-            v[j] += f[j] * inv_m[j];
-            x[j] += v[j] * a->dt;
+            vr[j] += fr[j] * im[j];
+            xr[j] += vr[j] * dt;
         }
-        for (int64_t p = 0; p < a->n_pairs; p++) { /* the inner lips touch; never cross */
-            int64_t u = 2 * a->lip_pairs[2 * p] + 1, lo = 2 * a->lip_pairs[2 * p + 1] + 1;
-            if (x[lo] > x[u]) {
-                double mid = 0.5 * (x[lo] + x[u]);
-                x[lo] = mid;
-                x[u] = mid;
-                double vm = 0.5 * (v[lo] + v[u]);
-                v[lo] = vm;
-                v[u] = vm;
+        for (int64_t p = 0; p < n_pairs; p++) { /* the inner lips touch; never cross */
+            int64_t u = 2 * pairs[2 * p] + 1, lo = 2 * pairs[2 * p + 1] + 1;
+            if (xr[lo] > xr[u]) {
+                double mid = 0.5 * (xr[lo] + xr[u]);
+                xr[lo] = mid;
+                xr[u] = mid;
+                double vm = 0.5 * (vr[lo] + vr[u]);
+                vr[lo] = vm;
+                vr[u] = vm;
             }
         }
-        for (; fi < a->n_frames && a->frame_pos[fi] <= (double)s + 0.5; fi++)
-            for (int64_t j = 0; j < m2; j++) out[fi * m2 + j] = x[j];
+        for (; fi < n_frames && frame_pos[fi] <= (double)s + 0.5; fi++)
+            for (int64_t j = 0; j < m2; j++) out[fi * m2 + j] = xr[j];
     }
     for (; fi < a->n_frames; fi++)
         for (int64_t j = 0; j < m2; j++) out[fi * m2 + j] = x[j];
