@@ -13,6 +13,7 @@ import asyncio
 import contextlib
 import itertools
 import logging
+import re
 import time
 from collections import OrderedDict
 from dataclasses import dataclass, field
@@ -26,6 +27,7 @@ from .protocol import End, Mouth, Start, pack_audio
 
 log = logging.getLogger("lipclock.channels")
 CLOSE_TOO_SLOW = 4008  # documented in docs/protocol.md
+CHANNEL_RE = re.compile(r"^[A-Za-z0-9_.-]{1,64}$")  # what a channel may be called
 _ids = itertools.count(1)
 
 
