@@ -17,16 +17,13 @@ Run: ``.venv/bin/python bench/bench_face_render.py``
 from __future__ import annotations
 
 import json
-import shutil
 import statistics
 import urllib.request
 
-from serverutil import percentile, running_server
+from serverutil import CHROMIUM, percentile, running_server
+from serverutil import CHROMIUM_ARGS as ARGS
 
 FRAMES = 400
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run"]
 NO_WEBGL = """
 const real = HTMLCanvasElement.prototype.getContext;
 HTMLCanvasElement.prototype.getContext = function (kind, ...rest) {

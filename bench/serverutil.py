@@ -1,4 +1,5 @@
-"""Start a real `lipclock serve` process on a free loopback port (shared by the server benches)."""
+"""Start a real `lipclock serve` process on a free loopback port, and the headless Chromium
+flags; shared by the benches and the browser tests (tests/client/browser_util.py)."""
 
 from __future__ import annotations
 
@@ -6,9 +7,11 @@ import asyncio
 import contextlib
 import os
 import random
+import shutil
 import socket
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import urllib.request
@@ -22,24 +25,47 @@ def free_port() -> int:
         return int(s.getsockname()[1])
 
 
-@contextlib.contextmanager
-def running_server(env: dict[str, str] | None = None) -> Iterator[tuple[str, subprocess.Popen]]:
-    port = free_port()
+# Debian's chromium, headless with software rendering, as the issue asks
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu",
+                 "--disable-background-networking", "--disable-component-update",
+                 "--disable-sync", "--no-first-run"]
+
+
+def start_server(env: dict[str, str] | None = None,
+                 port: int | None = None) -> tuple[str, subprocess.Popen]:
+    """Start `lipclock serve` as a user would; wait for /healthz (a cold first start on a
+    busy machine can take a while), and never leave the process behind on failure.
+    Returns the base URL and the process; the caller terminates it."""
+    port = port or free_port()
     exe = Path(sys.executable).with_name("lipclock")
+    log = tempfile.TemporaryFile()  # a file, not a pipe: a full pipe would block the server
     proc = subprocess.Popen([str(exe), "serve", "--port", str(port)],
                             env={**os.environ, **(env or {})},
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    url = f"127.0.0.1:{port}"
+                            stdout=subprocess.DEVNULL, stderr=log)
+    url = f"http://127.0.0.1:{port}"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
+        try:
+            urllib.request.urlopen(url + "/healthz", timeout=1)
+            log.close()  # the server keeps its own descriptor
+            return url, proc
+        except OSError:
+            time.sleep(0.1)
+    proc.kill()
+    proc.wait(timeout=10)
+    with log:
+        log.seek(0)
+        tail = log.read().decode(errors="replace")[-2000:]
+    raise RuntimeError(f"server did not start (exit {proc.returncode}): {tail}")
+
+
+@contextlib.contextmanager
+def running_server(env: dict[str, str] | None = None) -> Iterator[tuple[str, subprocess.Popen]]:
+    """start_server() as a context manager yielding "127.0.0.1:PORT" and the process."""
+    url, proc = start_server(env)
     try:
-        for _ in range(300):
-            try:
-                urllib.request.urlopen(f"http://{url}/healthz", timeout=1)
-                break
-            except OSError:
-                time.sleep(0.1)
-        else:
-            raise RuntimeError("server did not start")
-        yield url, proc
+        yield url.removeprefix("http://"), proc
     finally:
         proc.terminate()
         proc.wait(timeout=15)

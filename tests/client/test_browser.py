@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from browser_util import ARTIFACTS, HAVE_CHROMIUM, start_server
+from browser_util import ARTIFACTS, HAVE_CHROMIUM, lip_gaps_while_speaking, start_server
 
 pytestmark = pytest.mark.skipif(not HAVE_CHROMIUM, reason="Debian chromium missing")
 
@@ -99,11 +99,7 @@ def test_device_clock_mode_draws_the_mouth_from_the_servers_clock(device_server,
                            " === 'connected (device clock)'")
     assert page.is_hidden("#unlock")  # the server plays the sound: no prompt
     page.click("#speak")
-    page.wait_for_function("window.lipclockDebug.audioSample > 4000", timeout=15000)
-    gaps = []
-    for _ in range(30):
-        gaps.append(page.evaluate("window.lipclockDebug.lipGap"))
-        page.wait_for_timeout(30)
+    gaps = lip_gaps_while_speaking(page, 30, 30)
     assert max(gaps) > 3.0
     assert not errors, errors
     page.close()

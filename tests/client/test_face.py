@@ -8,7 +8,7 @@ from __future__ import annotations
 import base64
 
 import pytest
-from browser_util import FACE_ARTIFACTS, HAVE_CHROMIUM
+from browser_util import FACE_ARTIFACTS, HAVE_CHROMIUM, lip_gaps_while_speaking
 
 pytestmark = pytest.mark.skipif(not HAVE_CHROMIUM, reason="Debian chromium missing")
 LOOKS = ["wireframe", "shaded", "textured"]
@@ -88,11 +88,7 @@ def test_the_drawn_lip_gap_follows_speech_and_returns_to_rest(server, browser):
     page = open_page(browser, server)
     page.evaluate(CAPTURE_OPEN, 100.0)   # only tracks the peak
     page.click("#speak")
-    page.wait_for_function("window.lipclockDebug.audioSample > 4000", timeout=15000)
-    gaps = []
-    for _ in range(40):
-        gaps.append(page.evaluate("window.lipclockDebug.lipGap"))
-        page.wait_for_timeout(25)
+    gaps = lip_gaps_while_speaking(page, 40, 25)
     assert max(gaps) > 2.0 and min(gaps) < max(gaps)  # it opens and moves
     wait_until_silent(page)
     assert page.evaluate("window.lipclockDebug.lipGap") == pytest.approx(0, abs=0.05)
