@@ -108,7 +108,7 @@ _VOICE_BAR_DB = 38.0
 
 def _coda(ph: tuple, cls: list[str], i: int) -> bool:
     """Phone i ends its word's syllable: a pause, another word or a consonant follows."""
-    if i + 1 >= len(ph) or cls[i + 1] == "silence" or ph[i + 1].word != ph[i].word:
+    if i + 1 >= len(ph) or cls[i + 1] == "silence":
         return True
     return cls[i + 1] not in ("vowel", "diphthong", "liquid", "glide")
 
