@@ -249,6 +249,29 @@ def render_chunks(work: Work) -> Iterator[tuple[int, np.ndarray]]:
         start = end
 
 
+RENDER_PIECE_S = 1.0  # render_all's piece size: fewer kernel calls than streaming chunks
+
+
+def render_all(work: Work) -> np.ndarray:
+    """All the int16 samples at once: exactly :func:`render_chunks`' chunks concatenated
+    (any chunking renders the same samples), made in 1 s pieces into one array."""
+    assert work.timeline is not None
+    if work.samples is not None:  # system voice: the audio exists already
+        parts = [samples for _, samples in render_chunks(work)]
+        return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int16)
+    assert work.frames is not None
+    r = work.request
+    sr = r.prosody.sample_rate
+    renderer = klatt.KlattRenderer(work.frames, sr, r.voice, seed=0)
+    total = work.timeline.num_samples
+    out = np.empty(total, dtype=np.int16)
+    step = max(1, round(RENDER_PIECE_S * sr))
+    for start in range(0, total, step):
+        end = min(total, start + step)
+        out[start:end] = renderer.render_until(end)
+    return out
+
+
 def prepare_work(text: str, **options: Any) -> Work:
     request = make_request(text, **options)
     stages = SYSTEM_STAGES if request.system_voice else STAGES

@@ -16,7 +16,7 @@ from typing import Any, BinaryIO
 
 import numpy as np
 
-from .engine import Work, render_chunks
+from .engine import Work, render_all, render_chunks
 from .speech.phoneset import PAUSE
 from .speech.timeline import PhoneSpan, Timeline, WordSpan
 
@@ -145,6 +145,5 @@ class Prepared(_Marks):
             yield AudioChunk(start, samples)
 
     def render(self) -> Utterance:
-        parts = [c.samples for c in self.audio_chunks()]
-        samples = np.concatenate(parts) if parts else np.zeros(0, dtype=np.int16)
+        samples = render_all(self.work)  # the same samples as audio_chunks(), concatenated
         return Utterance(self.text, self.voice, self.timeline, self.visemes, self.mouth, samples)

@@ -2,6 +2,7 @@
  * stitching and slope limiting (face/bigram.py), node speed limit (face/models.py). */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "kernels.h"
 
@@ -10,73 +11,81 @@
 #define PY_MAX(a, b) ((b) > (a) ? (b) : (a))
 #define PY_MIN(a, b) ((b) < (a) ? (b) : (a))
 
+/* A node's (x, y) as one 2-lane vector: each lane does exactly the scalar arithmetic
+ * (IEEE, no fused multiply-add), two coordinates per instruction. */
+typedef double xy __attribute__((vector_size(16)));
+
 /* Step the mesh; after each step record the pose for every frame whose position
  * (in steps) is at most half a step past it; frames beyond the last step hold the
- * final pose. Arrays are flat x0, y0, x1, y1, ... */
+ * final pose. Arrays are flat x0, y0, x1, y1, ...
+ * Per viseme, the stiffness and damping of every node (closure visemes switch the lip
+ * nodes) and the target offset along every edge are tabulated once, so a step only
+ * reads them. */
 int spring_integrate(const spring_args *a, double *out) {
-    const int64_t n = a->n_nodes, m2 = 2 * n;
-    double *scratch = malloc(sizeof(double) * (size_t)(8 * m2 + 1));
+    const int64_t n = a->n_nodes, n_vis = a->n_visemes, n_edges = a->n_edges;
+    const size_t n_vec = (size_t)(4 * n + 3 * n * n_vis + n_edges * n_vis);
+    xy *scratch = aligned_alloc(sizeof(xy), sizeof(xy) * n_vec);
     if (scratch == NULL) return -1;
-    double *x = scratch, *v = x + m2, *f = v + m2, *inv_m = f + m2;
-    double *k_open = inv_m + m2, *c_open = k_open + m2;
-    double *k_close = c_open + m2, *c_close = k_close + m2;
+    xy *x = scratch, *v = x + n, *f = v + n, *inv_m = f + n;
+    xy *target = inv_m + n, *stiff = target + n * n_vis, *damp = stiff + n * n_vis;
+    xy *edge_rest = damp + n * n_vis; /* target[j] - target[i] per viseme and edge */
     for (int64_t i = 0; i < n; i++) {
-        for (int ax = 0; ax < 2; ax++) {
-            int64_t j = 2 * i + ax;
-            x[j] = a->rest[j];
-            v[j] = 0.0;
-            inv_m[j] = a->dt / a->mass[i];
-            k_open[j] = a->k[i];
-            c_open[j] = a->c[i];
-            k_close[j] = a->lips[i] ? a->k_cl : a->k[i];
-            c_close[j] = a->lips[i] ? a->c_cl : a->c[i];
+        x[i] = (xy){a->rest[2 * i], a->rest[2 * i + 1]};
+        v[i] = (xy){0.0, 0.0};
+        const double q = a->dt / a->mass[i];
+        inv_m[i] = (xy){q, q};
+    }
+    for (int64_t vi = 0; vi < n_vis; vi++) {
+        const double *t = a->targets + vi * 2 * n;
+        const int closing = a->closure[vi] != 0;
+        for (int64_t i = 0; i < n; i++) {
+            const double k = closing && a->lips[i] ? a->k_cl : a->k[i];
+            const double c = closing && a->lips[i] ? a->c_cl : a->c[i];
+            target[vi * n + i] = (xy){t[2 * i], t[2 * i + 1]};
+            stiff[vi * n + i] = (xy){k, k};
+            damp[vi * n + i] = (xy){c, c};
+        }
+        for (int64_t e = 0; e < n_edges; e++) {
+            const int64_t i = a->edges[2 * e], j = a->edges[2 * e + 1];
+            edge_rest[vi * n_edges + e] = (xy){t[2 * j] - t[2 * i],
+                                               t[2 * j + 1] - t[2 * i + 1]};
         }
     }
-    /* struct fields in locals and restrict-qualified arrays: the compiler may then keep
-     * them in registers instead of reloading after every store to f, x or v */
-    double *restrict xr = x, *restrict vr = v, *restrict fr = f;
-    const double *restrict im = inv_m;
-    const int64_t *restrict edges = a->edges, *restrict vis_idx = a->vis_idx;
-    const int64_t *restrict pairs = a->lip_pairs;
-    const uint8_t *restrict closure = a->closure;
-    const double *restrict targets = a->targets, *restrict frame_pos = a->frame_pos;
-    const int64_t n_edges = a->n_edges, n_pairs = a->n_pairs, n_frames = a->n_frames;
-    const double k_nb = a->k_nb, dt = a->dt;
+    const int64_t *restrict edges = a->edges, *restrict pairs = a->lip_pairs;
+    const double *restrict frame_pos = a->frame_pos;
+    const int64_t n_pairs = a->n_pairs, n_frames = a->n_frames, row = 2 * n;
+    const xy k_nb = {a->k_nb, a->k_nb}, dt = {a->dt, a->dt};
     int64_t fi = 0;
     for (int64_t s = 0; s < a->n_steps; s++) {
-        int64_t vi = vis_idx[s];
-        const double *restrict t = targets + vi * m2;
-        const double *restrict ks = closure[vi] ? k_close : k_open;
-        const double *restrict cs = closure[vi] ? c_close : c_open;
-        for (int64_t j = 0; j < m2; j++) fr[j] = ks[j] * (t[j] - xr[j]) - cs[j] * vr[j];
+        const int64_t vi = a->vis_idx[s];
+        const xy *restrict t = target + vi * n, *restrict k = stiff + vi * n;
+        const xy *restrict c = damp + vi * n, *restrict d = edge_rest + vi * n_edges;
+        for (int64_t i = 0; i < n; i++) f[i] = k[i] * (t[i] - x[i]) - c[i] * v[i];
         for (int64_t e = 0; e < n_edges; e++) {
-            int64_t i2 = 2 * edges[2 * e], j2 = 2 * edges[2 * e + 1];
-            for (int ax = 0; ax < 2; ax++) {
-                double stretch = (xr[j2 + ax] - xr[i2 + ax]) - (t[j2 + ax] - t[i2 + ax]);
-                fr[i2 + ax] += k_nb * stretch;
-                fr[j2 + ax] -= k_nb * stretch;
-            }
+            const int64_t i = edges[2 * e], j = edges[2 * e + 1];
+            const xy pull = k_nb * ((x[j] - x[i]) - d[e]);
+            f[i] += pull;
+            f[j] -= pull;
         }
-        for (int64_t j = 0; j < m2; j++) {
-            vr[j] += fr[j] * im[j];
-            xr[j] += vr[j] * dt;
+        for (int64_t i = 0; i < n; i++) {
+            v[i] += f[i] * inv_m[i];
+            x[i] += v[i] * dt;
         }
         for (int64_t p = 0; p < n_pairs; p++) { /* the inner lips touch; never cross */
-            int64_t u = 2 * pairs[2 * p] + 1, lo = 2 * pairs[2 * p + 1] + 1;
-            if (xr[lo] > xr[u]) {
-                double mid = 0.5 * (xr[lo] + xr[u]);
-                xr[lo] = mid;
-                xr[u] = mid;
-                double vm = 0.5 * (vr[lo] + vr[u]);
-                vr[lo] = vm;
-                vr[u] = vm;
+            const int64_t u = pairs[2 * p], lo = pairs[2 * p + 1]; /* [1]: the y lane */
+            if (x[lo][1] > x[u][1]) {
+                const double mid = 0.5 * (x[lo][1] + x[u][1]);
+                x[lo][1] = mid;
+                x[u][1] = mid;
+                const double vm = 0.5 * (v[lo][1] + v[u][1]);
+                v[lo][1] = vm;
+                v[u][1] = vm;
             }
         }
         for (; fi < n_frames && frame_pos[fi] <= (double)s + 0.5; fi++)
-            for (int64_t j = 0; j < m2; j++) out[fi * m2 + j] = xr[j];
+            memcpy(out + fi * row, x, sizeof(double) * (size_t)row);
     }
-    for (; fi < a->n_frames; fi++)
-        for (int64_t j = 0; j < m2; j++) out[fi * m2 + j] = x[j];
+    for (; fi < n_frames; fi++) memcpy(out + fi * row, x, sizeof(double) * (size_t)row);
     free(scratch);
     return 0;
 }

@@ -46,18 +46,25 @@ def limit_node_speed(nodes: np.ndarray, max_step_mm: float) -> np.ndarray:
     """No node moves more than ``max_step_mm`` between frames: it follows late instead.
 
     ``nodes`` is (n_frames, N, 2) mm; returns a new float64 array. The loop is C."""
+    out = np.array(nodes, dtype=np.float64)  # a fresh C-contiguous copy, limited in place
+    _limit_in_place(out, max_step_mm)
+    return out
+
+
+def _limit_in_place(nodes: np.ndarray, max_step_mm: float) -> None:
+    """:func:`limit_node_speed` on a C-contiguous float64 array, modified in place."""
     if nodes.ndim != 3 or nodes.shape[2] != 2:
         raise ValueError(f"nodes must be (n_frames, N, 2), got {nodes.shape}")
-    out = np.array(nodes, dtype=np.float64)  # a fresh C-contiguous copy, limited in place
-    if out.size:
-        _kernels.limit_node_speed(out, out.shape[1], float(max_step_mm))
-    return out
+    if nodes.size:
+        _kernels.limit_node_speed(nodes, nodes.shape[1], float(max_step_mm))
 
 
 def _track(timeline: Timeline, rate_hz: float, model: str, nodes: np.ndarray) -> MouthTrack:
     # the documented physiological limit holds for every model (spring and bigram already
-    # stay under it; the interpolation baselines can exceed it in fast speech)
-    nodes = limit_node_speed(nodes.astype(np.float64), MAX_NODE_SPEED_MM_S / rate_hz)
+    # stay under it; the interpolation baselines can exceed it in fast speech). ``nodes``
+    # is the model's own new array: limited in place (converted first if not float64).
+    nodes = np.ascontiguousarray(nodes, dtype=np.float64)
+    _limit_in_place(nodes, MAX_NODE_SPEED_MM_S / rate_hz)
     nodes = nodes.astype(np.float32)
     return MouthTrack(timeline.sample_rate, rate_hz, model, NODES, nodes,
                       measures_from_nodes(nodes))

@@ -181,7 +181,8 @@ def spring_nodes(timeline: Timeline, rate_hz: float, d: Dynamics) -> np.ndarray:
     starts = np.array([p.start for p in timeline.phones]) - lead
     pidx = np.clip(np.searchsorted(starts, np.arange(n_steps) * step, side="right") - 1, 0,
                    len(timeline.phones) - 1)
-    vis_idx = np.array([names.index(viseme_of(p.phone)) for p in timeline.phones])[pidx]
+    index = {n: i for i, n in enumerate(names)}
+    vis_idx = np.array([index[viseme_of(p.phone)] for p in timeline.phones])[pidx]
     lips = np.zeros(len(NODES), dtype=np.bool_)
     lips[LIP_NODES] = True
     n_frames = int(math.floor(timeline.num_samples * rate_hz / sr)) + 1

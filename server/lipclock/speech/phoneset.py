@@ -70,7 +70,14 @@ def stress(phone: str) -> int | None:
 
 def info(phone: str) -> PhoneInfo:
     """Features of a phone string (stress digit allowed). Raises KeyError if unknown."""
-    return phones()[base(phone)]
+    hit = _info_by_string().get(phone)
+    return hit if hit is not None else phones()[base(phone)]
+
+
+@cache
+def _info_by_string() -> dict[str, PhoneInfo]:
+    """phones() keyed by every phone string as written (tracks.py asks per phone)."""
+    return {name + d: p for name, p in phones().items() for d in ("", "0", "1", "2")}
 
 
 def is_valid(phone: str) -> bool:

@@ -91,28 +91,33 @@ def build_timeline(items: Sequence[Pronounced], s: ProsodySettings) -> Timeline:
     t = 0.0
     pos = 0
 
-    def emit(phone: str, dur_s: float, word: int) -> PhoneSpan:
+    def pause(dur_s: float) -> None:
         nonlocal t, pos
         t += dur_s
         end = max(pos, round(t * sr))
-        span = PhoneSpan(phone, pos, end, word)
-        phone_spans.append(span)
+        phone_spans.append(PhoneSpan(PAUSE, pos, end, -1))
         pos = end
-        return span
 
     base_hz = s.base_f0_hz
-    emit(PAUSE, LEAD_SILENCE_S, -1)
+    pause(LEAD_SILENCE_S)
     phrases = split_phrases(items)
     for n, phrase in enumerate(phrases):
         durs = phrase_durations_s(phrase, scale)
         start = pos
         vowels: list[tuple[PhoneSpan, bool]] = []  # (span, accented)
+        single = len(phrase.words) == 1
         for word, wd in zip(phrase.words, durs, strict=True):
             wi = len(word_spans)
             first = pos
-            accentable = word.text not in fw or len(phrase.words) == 1
-            for ph, d in zip(word.phones, wd, strict=True):
-                span = emit(ph, d, wi)
+            accentable = word.text not in fw or single
+            for ph, d in zip(word.phones, wd, strict=True):  # the phones, inline: hot
+                t += d
+                end = round(t * sr)
+                if end < pos:  # max(pos, ...) without the call
+                    end = pos
+                span = PhoneSpan(ph, pos, end, wi)
+                phone_spans.append(span)
+                pos = end
                 if ph[-1].isdigit():
                     vowels.append((span, accentable and ph[-1] == "1"))
             word_spans.append(WordSpan(word.text, first, pos, word.orth, word.source))
@@ -122,9 +127,9 @@ def build_timeline(items: Sequence[Pronounced], s: ProsodySettings) -> Timeline:
         gap = TAIL_SILENCE_S if is_last else pause_s(phrase.end, s.comma_pause_s,
                                                           s.period_pause_s)
         if gap > 0:
-            emit(PAUSE, gap, -1)
+            pause(gap)
     if not phrases:
-        emit(PAUSE, TAIL_SILENCE_S, -1)
+        pause(TAIL_SILENCE_S)
     f0.sort(key=lambda p: p.sample)
     if not f0:
         f0 = [F0Point(0, base_hz)]
