@@ -266,6 +266,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--systems", default=None,
                     help="comma-separated subset of: " + ", ".join(available_systems()))
     ap.add_argument("--seed", type=int, default=1, help="item sample seed (with --items)")
+    ap.add_argument("--sentences-file", type=Path, default=None,
+                    help="sentences from this file instead (e.g. "
+                    "bench/intelligibility/sentences_heldout.txt)")
+    ap.add_argument("--items-file", type=Path, default=None,
+                    help="rhyme items from this file instead (e.g. a held-out set made by "
+                    "rhyme_sets.py --seed N -o FILE)")
     ap.add_argument("--workers", type=int, default=2, choices=(1, 2))
     ap.add_argument("--show-errors", action="store_true", help="print each miss")
     args = ap.parse_args(argv)
@@ -277,8 +283,8 @@ def main(argv: list[str] | None = None) -> int:
         if unknown:
             ap.error(f"unknown systems {unknown}; available: {', '.join(systems)}")
         systems = wanted
-    items = read_items()
-    sentences = read_sentences()
+    items = read_items(args.items_file) if args.items_file else read_items()
+    sentences = read_sentences(args.sentences_file) if args.sentences_file else read_sentences()
     n_items = args.items if args.items is not None else (60 if args.quick else len(items))
     n_sent = args.sentences if args.sentences is not None else (10 if args.quick else
                                                                  len(sentences))
