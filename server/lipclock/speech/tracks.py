@@ -154,6 +154,7 @@ def _target_for(phone: str) -> Target:
 _PAR = (("AF", kp.AF), ("A2", kp.A2), ("A3", kp.A3), ("A4", kp.A4), ("A5", kp.A5),
         ("A6", kp.A6), ("AB", kp.AB))
 _SRC_COLS = [kp.AV, kp.AH] + [col for _, col in _PAR]
+assert _SRC_COLS == [kp.AV, kp.AH, kp.AF, *range(kp.A2, kp.AB + 1)]  # copied as two slices
 
 
 @dataclass(frozen=True, slots=True)
@@ -280,11 +281,13 @@ def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
     sr = timeline.sample_rate
     n = kp.n_frames_for(timeline.num_samples, sr)
     fs = np.round(np.arange(n) * (sr / kp.FRAME_RATE_HZ)).astype(np.int64)
-    out = np.zeros((n, kp.N_PARAMS), dtype=np.float64)
+    row = np.zeros(kp.N_PARAMS)
     for col, v in _DEFAULTS.items():
-        out[:, col] = v
-    out[:, kp.OQ] = voice.open_quotient
-    out[:, kp.TL] = voice.tilt_db
+        row[col] = v
+    row[kp.OQ] = voice.open_quotient
+    row[kp.TL] = voice.tilt_db
+    out = np.empty((n, kp.N_PARAMS), dtype=np.float64)
+    out[:] = row
     out[:, kp.F0] = timeline.f0_at(fs)
     ph = timeline.phones
     if not ph:
@@ -383,14 +386,22 @@ def _formants(out: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray,
     trans = _TRANS_S_BY_CLASS[cls]
     # CV transitions from stops/nasals are the long, audible ones
     trans[_VOCALIC[cls] & _CLOSED[u.prev]] = 0.06
-    x = np.clip((t / dur - 0.2) / 0.6, 0.0, 1.0)
-    glide = (x * x * (3 - 2 * x))[:, None]
-    base = starts[pidx] + (ends - starts)[pidx] * glide
     tr = np.minimum(trans[pidx], 0.5 * dur)
     safe = np.where(tr > 0, tr, 1.0)
-    wl = np.where(tr > 0, np.clip(1.0 - t / safe, 0.0, 1.0), 0.0)[:, None]
-    wr = np.where(tr > 0, np.clip(1.0 - (dur - t) / safe, 0.0, 1.0), 0.0)[:, None]
-    vals = base + (bounds[:-1] - starts)[pidx] * wl + (bounds[1:] - ends)[pidx] * wr
+    wl = np.where(tr > 0, np.clip(1.0 - t / safe, 0.0, 1.0), 0.0)
+    wr = np.where(tr > 0, np.clip(1.0 - (dur - t) / safe, 0.0, 1.0), 0.0)
+    # Each frame is its phone's target plus whichever of the terms below are not
+    # zero (formants are positive, so adding a zero term changes no bit).
+    vals = starts[pidx]
+    # diphthongs glide from the first target to the second in the middle of the vowel
+    gl = np.flatnonzero(np.any(ends != starts, axis=1)[pidx])
+    x = np.clip((t[gl] / dur[gl] - 0.2) / 0.6, 0.0, 1.0)
+    vals[gl] += (ends - starts)[pidx[gl]] * (x * x * (3 - 2 * x))[:, None]
+    # transitions: from the boundary value at the start, toward the one at the end
+    fl = np.flatnonzero(wl > 0)
+    vals[fl] += (bounds[:-1] - starts)[pidx[fl]] * wl[fl, None]
+    fr = np.flatnonzero(wr > 0)
+    vals[fr] += (bounds[1:] - ends)[pidx[fr]] * wr[fr, None]
     # stops hold the locus of the vowel they release into, so the burst (parallel
     # F2..F6) is shaped by the CV locus, e.g. velar bursts sit at the F2/F3 pinch
     # of the following vowel (Stevens 1998 ch. 7); before a pause, the VC locus
@@ -398,7 +409,9 @@ def _formants(out: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray,
     hold = np.where(released[:, None], bounds[1:], bounds[:-1])
     stop_f = np.flatnonzero((cls == _STOP)[pidx])
     vals[stop_f] = hold[pidx[stop_f]]
-    out[:, _FORMANT_COLS] = vals
+    out[:, kp.F1:kp.F3 + 1] = vals[:, :3]
+    out[:, kp.B1:kp.B3 + 1] = vals[:, 3:6]
+    out[:, kp.FNZ] = vals[:, 6]
 
 
 def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
@@ -438,18 +451,25 @@ def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
     glottal = (_VOCALIC[cls] & (u.word >= 0) & (_shift_right(u.word, -1) != u.word)
                & _class_set("vowel", "diphthong", "silence")[prv])
     glottal[0] = False
-    bl = np.minimum(burst_s[pidx], np.where(burst_s[pidx] >= 0.5, 0.65, 0.5) * dur)
-    in_burst = (burst_s[pidx] > 0) & (t >= dur - bl)
-    vals = np.where(in_burst[:, None], burst[pidx], closure[pidx])
-    into_burst = np.clip((t - (dur - bl)) / np.maximum(bl, 1e-3), 0.0, 1.0)
-    decay = np.where(in_burst, burst_decay[pidx] * into_burst, 0.0)
-    vals[:, 2] = np.where(vals[:, 2] > 0, np.maximum(vals[:, 2] - decay, 1.0), 0.0)
+    vals = closure[pidx]
+    # the burst takes the end of the phone; the transient decays over it
+    bf = np.flatnonzero(burst_s[pidx] > 0)  # frames of stops and affricates
+    bs, bd = burst_s[pidx[bf]], dur[bf]
+    bl = np.minimum(bs, np.where(bs >= 0.5, 0.65, 0.5) * bd)
+    in_burst = t[bf] >= bd - bl
+    bf, bl, bd = bf[in_burst], bl[in_burst], bd[in_burst]
+    vals[bf] = burst[pidx[bf]]
+    into_burst = np.clip((t[bf] - (bd - bl)) / np.maximum(bl, 1e-3), 0.0, 1.0)
+    af = vals[:, 2].copy()
+    af[bf] -= burst_decay[pidx[bf]] * into_burst
+    vals[:, 2] = np.where(vals[:, 2] > 0, np.maximum(af, 1.0), 0.0)
     fall = np.clip((t / dur - 0.6) / 0.4, 0.0, 1.0)
     vals[:, 0] -= np.where(final_decay[pidx], 8.0 * fall, 0.0)  # phrase-final decay
     asp = fs < asp_until[pidx]
     vals[asp, 0] = 0.0
     vals[asp, 1] = 58.0
     vals[:, 0] -= np.where(glottal[pidx] & (t < 0.25 * dur), 12.0, 0.0)
-    out[:, _SRC_COLS] = vals
+    out[:, kp.AV:kp.AF + 1] = vals[:, :3]
+    out[:, kp.A2:kp.AB + 1] = vals[:, 3:]
     f6 = rows.high_f6[u.row][pidx]
     out[:, kp.F6] = np.where(f6 > 0, f6, out[:, kp.F6])
