@@ -154,7 +154,6 @@ def _target_for(phone: str) -> Target:
 _PAR = (("AF", kp.AF), ("A2", kp.A2), ("A3", kp.A3), ("A4", kp.A4), ("A5", kp.A5),
         ("A6", kp.A6), ("AB", kp.AB))
 _SRC_COLS = [kp.AV, kp.AH] + [col for _, col in _PAR]
-assert _SRC_COLS == [kp.AV, kp.AH, kp.AF, *range(kp.A2, kp.AB + 1)]  # copied as two slices
 
 
 @dataclass(frozen=True, slots=True)
@@ -281,17 +280,19 @@ def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
     sr = timeline.sample_rate
     n = kp.n_frames_for(timeline.num_samples, sr)
     fs = np.round(np.arange(n) * (sr / kp.FRAME_RATE_HZ)).astype(np.int64)
-    row = np.zeros(kp.N_PARAMS)
+    # The rules write one parameter track (a row here) at a time; transposed to
+    # frames at the end.
+    fixed = np.zeros(kp.N_PARAMS)
     for col, v in _DEFAULTS.items():
-        row[col] = v
-    row[kp.OQ] = voice.open_quotient
-    row[kp.TL] = voice.tilt_db
-    out = np.empty((n, kp.N_PARAMS), dtype=np.float64)
-    out[:] = row
-    out[:, kp.F0] = timeline.f0_at(fs)
+        fixed[col] = v
+    fixed[kp.OQ] = voice.open_quotient
+    fixed[kp.TL] = voice.tilt_db
+    out = np.empty((kp.N_PARAMS, n), dtype=np.float64)
+    out[:] = fixed[:, None]
+    out[kp.F0] = timeline.f0_at(fs)
     ph = timeline.phones
     if not ph:
-        return out.astype(np.float32)
+        return np.ascontiguousarray(out.T, dtype=np.float32)
     u = _Phones.of(ph)
     starts, ends = _steady(u)
     bounds = _boundaries(u, starts, ends)
@@ -303,13 +304,13 @@ def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
     # The synthesizer scales F1..F6 by the voice's tract length but not the nasal
     # pair. The murmur's zero exists to cancel F1 (Klatt 1980), so where it is in
     # use (not parked on the pole) it must move with the scaled F1.
-    nz = out[:, kp.FNZ]
-    out[:, kp.FNZ] = np.where(np.abs(nz - out[:, kp.FNP]) > 1.0, nz * voice.formant_scale, nz)
+    nz = out[kp.FNZ]
+    out[kp.FNZ] = np.where(np.abs(nz - out[kp.FNP]) > 1.0, nz * voice.formant_scale, nz)
     _sources(out, fs, t, dur, pidx, u, sr)
     # smooth voicing onsets/offsets only (never AF/AH/A*: keeps bursts sharp)
-    av = out[:, kp.AV].copy()
-    out[1:-1, kp.AV] = 0.25 * av[:-2] + 0.5 * av[1:-1] + 0.25 * av[2:]
-    return out.astype(np.float32)
+    av = out[kp.AV].copy()
+    out[kp.AV, 1:-1] = 0.25 * av[:-2] + 0.5 * av[1:-1] + 0.25 * av[2:]
+    return np.ascontiguousarray(out.T, dtype=np.float32)
 
 
 def _steady(u: _Phones) -> tuple[np.ndarray, np.ndarray]:
@@ -381,7 +382,9 @@ _FORMANT_COLS = [kp.F1, kp.F2, kp.F3, kp.B1, kp.B2, kp.B3, kp.FNZ]
 
 def _formants(out: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray,
               starts: np.ndarray, ends: np.ndarray, bounds: np.ndarray, u: _Phones) -> None:
-    """Steady targets (gliding for diphthongs) plus linear transitions from each boundary."""
+    """Steady targets (gliding for diphthongs) plus linear transitions from each boundary.
+
+    ``out`` holds one parameter track per row (N_PARAMS, n_frames)."""
     cls = u.cls
     trans = _TRANS_S_BY_CLASS[cls]
     # CV transitions from stops/nasals are the long, audible ones
@@ -392,32 +395,32 @@ def _formants(out: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray,
     wr = np.where(tr > 0, np.clip(1.0 - (dur - t) / safe, 0.0, 1.0), 0.0)
     # Each frame is its phone's target plus whichever of the terms below are not
     # zero (formants are positive, so adding a zero term changes no bit).
-    vals = starts[pidx]
+    # Rows F1 F2 F3 B1 B2 B3 FNZ, one column per phone (bounds: per boundary).
+    starts, ends, bounds = (np.ascontiguousarray(a.T) for a in (starts, ends, bounds))
+    vals = np.take(starts, pidx, axis=1)
     # diphthongs glide from the first target to the second in the middle of the vowel
-    gl = np.flatnonzero(np.any(ends != starts, axis=1)[pidx])
+    gl = np.flatnonzero(np.any(ends != starts, axis=0)[pidx])
     x = np.clip((t[gl] / dur[gl] - 0.2) / 0.6, 0.0, 1.0)
-    vals[gl] += (ends - starts)[pidx[gl]] * (x * x * (3 - 2 * x))[:, None]
+    vals[:, gl] += (ends - starts)[:, pidx[gl]] * (x * x * (3 - 2 * x))
     # transitions: from the boundary value at the start, toward the one at the end
     fl = np.flatnonzero(wl > 0)
-    vals[fl] += (bounds[:-1] - starts)[pidx[fl]] * wl[fl, None]
+    vals[:, fl] += (bounds[:, :-1] - starts)[:, pidx[fl]] * wl[fl]
     fr = np.flatnonzero(wr > 0)
-    vals[fr] += (bounds[1:] - ends)[pidx[fr]] * wr[fr, None]
+    vals[:, fr] += (bounds[:, 1:] - ends)[:, pidx[fr]] * wr[fr]
     # stops hold the locus of the vowel they release into, so the burst (parallel
     # F2..F6) is shaped by the CV locus, e.g. velar bursts sit at the F2/F3 pinch
     # of the following vowel (Stevens 1998 ch. 7); before a pause, the VC locus
     released = u.next != _SILENCE
-    hold = np.where(released[:, None], bounds[1:], bounds[:-1])
+    hold = np.where(released, bounds[:, 1:], bounds[:, :-1])
     stop_f = np.flatnonzero((cls == _STOP)[pidx])
-    vals[stop_f] = hold[pidx[stop_f]]
-    out[:, kp.F1:kp.F3 + 1] = vals[:, :3]
-    out[:, kp.B1:kp.B3 + 1] = vals[:, 3:6]
-    out[:, kp.FNZ] = vals[:, 6]
+    vals[:, stop_f] = hold[:, pidx[stop_f]]
+    out[_FORMANT_COLS] = vals
 
 
 def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
              pidx: np.ndarray, u: _Phones, sr: int) -> None:
     """Source amplitudes: per-phone closure and burst rows, then masks for bursts,
-    aspiration, phrase-final decay and glottal stops."""
+    aspiration, phrase-final decay and glottal stops. ``out`` as in _formants."""
     rows = _phone_rows()
     n_ph = len(u.row)
     cls, nxt, prv = u.cls, u.next, u.prev
@@ -451,25 +454,25 @@ def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
     glottal = (_VOCALIC[cls] & (u.word >= 0) & (_shift_right(u.word, -1) != u.word)
                & _class_set("vowel", "diphthong", "silence")[prv])
     glottal[0] = False
-    vals = closure[pidx]
+    # rows AV AH AF A2..A6 AB, one column per frame
+    vals = np.take(closure.T, pidx, axis=1)
     # the burst takes the end of the phone; the transient decays over it
     bf = np.flatnonzero(burst_s[pidx] > 0)  # frames of stops and affricates
     bs, bd = burst_s[pidx[bf]], dur[bf]
     bl = np.minimum(bs, np.where(bs >= 0.5, 0.65, 0.5) * bd)
     in_burst = t[bf] >= bd - bl
     bf, bl, bd = bf[in_burst], bl[in_burst], bd[in_burst]
-    vals[bf] = burst[pidx[bf]]
+    vals[:, bf] = burst.T[:, pidx[bf]]
     into_burst = np.clip((t[bf] - (bd - bl)) / np.maximum(bl, 1e-3), 0.0, 1.0)
-    af = vals[:, 2].copy()
+    af = vals[2].copy()
     af[bf] -= burst_decay[pidx[bf]] * into_burst
-    vals[:, 2] = np.where(vals[:, 2] > 0, np.maximum(af, 1.0), 0.0)
+    vals[2] = np.where(vals[2] > 0, np.maximum(af, 1.0), 0.0)
     fall = np.clip((t / dur - 0.6) / 0.4, 0.0, 1.0)
-    vals[:, 0] -= np.where(final_decay[pidx], 8.0 * fall, 0.0)  # phrase-final decay
+    vals[0] -= np.where(final_decay[pidx], 8.0 * fall, 0.0)  # phrase-final decay
     asp = fs < asp_until[pidx]
-    vals[asp, 0] = 0.0
-    vals[asp, 1] = 58.0
-    vals[:, 0] -= np.where(glottal[pidx] & (t < 0.25 * dur), 12.0, 0.0)
-    out[:, kp.AV:kp.AF + 1] = vals[:, :3]
-    out[:, kp.A2:kp.AB + 1] = vals[:, 3:]
+    vals[0, asp] = 0.0
+    vals[1, asp] = 58.0
+    vals[0] -= np.where(glottal[pidx] & (t < 0.25 * dur), 12.0, 0.0)
+    out[_SRC_COLS] = vals
     f6 = rows.high_f6[u.row][pidx]
-    out[:, kp.F6] = np.where(f6 > 0, f6, out[:, kp.F6])
+    out[kp.F6] = np.where(f6 > 0, f6, out[kp.F6])
