@@ -280,19 +280,19 @@ def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
     sr = timeline.sample_rate
     n = kp.n_frames_for(timeline.num_samples, sr)
     fs = np.round(np.arange(n) * (sr / kp.FRAME_RATE_HZ)).astype(np.int64)
-    # The rules write one parameter track (a row here) at a time; transposed to
-    # frames at the end.
+    # One float32 row per parameter track, transposed to frames at the end. The
+    # rules compute in float64 and each track is rounded once, as it is stored.
     fixed = np.zeros(kp.N_PARAMS)
     for col, v in _DEFAULTS.items():
         fixed[col] = v
     fixed[kp.OQ] = voice.open_quotient
     fixed[kp.TL] = voice.tilt_db
-    out = np.empty((kp.N_PARAMS, n), dtype=np.float64)
+    out = np.empty((kp.N_PARAMS, n), dtype=np.float32)
     out[:] = fixed[:, None]
     out[kp.F0] = timeline.f0_at(fs)
     ph = timeline.phones
     if not ph:
-        return np.ascontiguousarray(out.T, dtype=np.float32)
+        return np.ascontiguousarray(out.T)
     u = _Phones.of(ph)
     starts, ends = _steady(u)
     bounds = _boundaries(u, starts, ends)
@@ -300,17 +300,20 @@ def klatt_frames(timeline: Timeline, voice: Voice) -> np.ndarray:
     pidx = np.clip(np.searchsorted(u.end, fs, side="right"), 0, n_ph - 1)
     t = (fs - u.start[pidx]) / sr
     dur = np.maximum((u.end - u.start) / sr, 1e-3)[pidx]
-    _formants(out, t, dur, pidx, starts, ends, bounds, u)
+    formants = _formants(t, dur, pidx, starts, ends, bounds, u)
     # The synthesizer scales F1..F6 by the voice's tract length but not the nasal
     # pair. The murmur's zero exists to cancel F1 (Klatt 1980), so where it is in
     # use (not parked on the pole) it must move with the scaled F1.
-    nz = out[kp.FNZ]
-    out[kp.FNZ] = np.where(np.abs(nz - out[kp.FNP]) > 1.0, nz * voice.formant_scale, nz)
-    _sources(out, fs, t, dur, pidx, u, sr)
+    nz = formants[_FORMANT_COLS.index(kp.FNZ)]
+    nz[:] = np.where(np.abs(nz - _DEFAULTS[kp.FNP]) > 1.0, nz * voice.formant_scale, nz)
+    out[_FORMANT_COLS] = formants
+    amps, f6 = _sources(fs, t, dur, pidx, u, sr)
+    out[kp.F6] = f6
     # smooth voicing onsets/offsets only (never AF/AH/A*: keeps bursts sharp)
-    av = out[kp.AV].copy()
-    out[kp.AV, 1:-1] = 0.25 * av[:-2] + 0.5 * av[1:-1] + 0.25 * av[2:]
-    return np.ascontiguousarray(out.T, dtype=np.float32)
+    av = amps[0].copy()
+    amps[0, 1:-1] = 0.25 * av[:-2] + 0.5 * av[1:-1] + 0.25 * av[2:]
+    out[_SRC_COLS] = amps
+    return np.ascontiguousarray(out.T)
 
 
 def _steady(u: _Phones) -> tuple[np.ndarray, np.ndarray]:
@@ -380,11 +383,10 @@ def _boundaries(u: _Phones, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
 _FORMANT_COLS = [kp.F1, kp.F2, kp.F3, kp.B1, kp.B2, kp.B3, kp.FNZ]
 
 
-def _formants(out: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray,
-              starts: np.ndarray, ends: np.ndarray, bounds: np.ndarray, u: _Phones) -> None:
-    """Steady targets (gliding for diphthongs) plus linear transitions from each boundary.
-
-    ``out`` holds one parameter track per row (N_PARAMS, n_frames)."""
+def _formants(t: np.ndarray, dur: np.ndarray, pidx: np.ndarray, starts: np.ndarray,
+              ends: np.ndarray, bounds: np.ndarray, u: _Phones) -> np.ndarray:
+    """Tracks (7, n_frames) of F1 F2 F3 B1 B2 B3 FNZ: steady targets (gliding for
+    diphthongs) plus linear transitions from each boundary."""
     cls = u.cls
     trans = _TRANS_S_BY_CLASS[cls]
     # CV transitions from stops/nasals are the long, audible ones
@@ -414,7 +416,7 @@ def _formants(out: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray,
     hold = np.where(released, bounds[:, 1:], bounds[:, :-1])
     stop_f = np.flatnonzero((cls == _STOP)[pidx])
     vals[:, stop_f] = hold[:, pidx[stop_f]]
-    out[_FORMANT_COLS] = vals
+    return vals
 
 
 def _add_term(vals: np.ndarray, frames: np.ndarray, per_phone: np.ndarray, pidx: np.ndarray,
@@ -426,10 +428,12 @@ def _add_term(vals: np.ndarray, frames: np.ndarray, per_phone: np.ndarray, pidx:
         track[frames] += term[at] * weight
 
 
-def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
-             pidx: np.ndarray, u: _Phones, sr: int) -> None:
-    """Source amplitudes: per-phone closure and burst rows, then masks for bursts,
-    aspiration, phrase-final decay and glottal stops. ``out`` as in _formants."""
+def _sources(fs: np.ndarray, t: np.ndarray, dur: np.ndarray, pidx: np.ndarray, u: _Phones,
+             sr: int) -> tuple[np.ndarray, np.ndarray]:
+    """Source amplitude tracks (9, n_frames) of AV AH AF A2..A6 AB, and the F6 track.
+
+    Per-phone closure and burst rows, then masks for bursts, aspiration,
+    phrase-final decay and glottal stops."""
     rows = _phone_rows()
     n_ph = len(u.row)
     cls, nxt, prv = u.cls, u.next, u.prev
@@ -482,6 +486,5 @@ def _sources(out: np.ndarray, fs: np.ndarray, t: np.ndarray, dur: np.ndarray,
     vals[0, asp] = 0.0
     vals[1, asp] = 58.0
     vals[0] -= np.where(glottal[pidx] & (t < 0.25 * dur), 12.0, 0.0)
-    out[_SRC_COLS] = vals
     f6 = rows.high_f6[u.row][pidx]
-    out[kp.F6] = np.where(f6 > 0, f6, out[kp.F6])
+    return vals, np.where(f6 > 0, f6, _DEFAULTS[kp.F6])
