@@ -1,8 +1,8 @@
 """Parameter tracks: Timeline -> one Klatt parameter frame every 5 ms.
 
-Per-phone targets come from ``data/klatt_targets.tsv``. The rules that make
-them speech (after Klatt 1980 and the Holmes-Mattingly-Shearme boundary
-scheme used by rule synthesizers):
+Per-phone targets come from ``data/klatt_targets.tsv`` (read by targets.py).
+The rules that make them speech (after Klatt 1980 and the Holmes-Mattingly-Shearme
+boundary scheme used by rule synthesizers):
 
 * formant transitions: at each consonant-vowel boundary the formants start at a
   locus mix ``k * consonant + (1 - k) * vowel`` and move to the vowel target
@@ -26,60 +26,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cache
-from pathlib import Path
 
 import numpy as np
 
-from ..errors import TableError
-from ..tables import finite_float, iter_tsv, package_file
 from . import klatt_params as kp
 from .phoneset import PAUSE, info, phones
+from .targets import FORMANT_FIELDS_N, target_for
 from .timeline import Timeline
 from .voices import Voice
-
-COLS = ("F1", "F2", "F3", "B1", "B2", "B3", "AV", "AF", "AH", "A2", "A3", "A4", "A5", "A6",
-        "AB", "FNZ")
-_FORM = 7  # F1 F2 F3 B1 B2 B3 FNZ are blended with transitions
-
-
-@dataclass(frozen=True, slots=True)
-class Target:
-    phone: str
-    values: dict[str, float]
-    start: np.ndarray  # (7,) F1 F2 F3 B1 B2 B3 FNZ at the start
-    end: np.ndarray  # same at the end (differs for diphthongs)
-
-
-def load_targets(path: Path) -> dict[str, Target]:
-    known = set(phones()) - {PAUSE} | {"AX"}
-    out: dict[str, Target] = {}
-    for line, fields in iter_tsv(path):
-        name = fields[0]
-        if name not in known:
-            raise TableError(path, line, f"unknown phone {name!r}")
-        if len(fields) not in (len(COLS) + 1, len(COLS) + 4):
-            raise TableError(path, line, f"expected {len(COLS) + 1} or {len(COLS) + 4} columns, "
-                                         f"got {len(fields)}")
-        nums = [finite_float(path, line, c, v) for c, v in zip(COLS, fields[1:], strict=False)]
-        vals = dict(zip(COLS, nums, strict=True))
-        start = np.array([vals["F1"], vals["F2"], vals["F3"], vals["B1"], vals["B2"], vals["B3"],
-                          vals["FNZ"]])
-        end = start.copy()
-        if len(fields) == len(COLS) + 4:
-            end[:3] = [finite_float(path, line, "F*b", v) for v in fields[len(COLS) + 1:]]
-        if np.any(start[:6] <= 0) or np.any(end[:3] <= 0):
-            raise TableError(path, line, "formants and bandwidths must be positive")
-        out[name] = Target(name, vals, start, end)
-    missing = sorted(known - set(out))
-    if missing:
-        raise TableError(path, 1, f"no targets for: {' '.join(missing)}")
-    return out
-
-
-@cache
-def targets() -> dict[str, Target]:
-    return load_targets(package_file("lipclock.speech", "data/klatt_targets.tsv"))
-
 
 # Locus weight k: how strongly a consonant pulls the boundary formants toward itself.
 _LOCUS_K = {"stop": 0.55, "affricate": 0.5, "fricative": 0.5, "nasal": 0.5, "liquid": 0.45,
@@ -138,19 +92,6 @@ _VELAR = frozenset({"K", "G", "NG"})
 _NO_FORMANTS = np.array([500.0, 1500.0, 2500.0, 80.0, 100.0, 150.0, 270.0])  # all-pause input
 
 
-def _target_for(phone: str) -> Target:
-    t = targets()
-    b = phone.rstrip("012")
-    if b == "AH" and phone.endswith("0"):
-        return t["AX"]
-    tgt = t[b]
-    if phone.endswith("0") and b not in ("ER", "IY", "IH", "UW", "OW"):
-        ax = t["AX"]  # reduce unstressed vowels 30% toward schwa
-        return Target(tgt.phone, tgt.values, 0.7 * tgt.start + 0.3 * ax.start,
-                      0.7 * tgt.end + 0.3 * ax.end)
-    return tgt
-
-
 _PAR = (("AF", kp.AF), ("A2", kp.A2), ("A3", kp.A3), ("A4", kp.A4), ("A5", kp.A5),
         ("A6", kp.A6), ("AB", kp.AB))
 _SRC_COLS = [kp.AV, kp.AH] + [col for _, col in _PAR]
@@ -182,8 +123,9 @@ def _phone_rows() -> _PhoneRows:
     names = [PAUSE] + [name + d for name, p in phones().items() if name != PAUSE
                        for d in ("", "0", "1", "2")]
     n = len(names)
-    rows = {"cls": np.zeros(n, dtype=np.int64), "start": np.zeros((n, _FORM)),
-            "end": np.zeros((n, _FORM)), "av": np.zeros(n), "par": np.zeros((n, len(_PAR))),
+    rows = {"cls": np.zeros(n, dtype=np.int64), "start": np.zeros((n, FORMANT_FIELDS_N)),
+            "end": np.zeros((n, FORMANT_FIELDS_N)), "av": np.zeros(n),
+            "par": np.zeros((n, len(_PAR))),
             "closure": np.zeros((n, len(_SRC_COLS))), "burst_s": np.zeros(n),
             "high_f6": np.zeros(n)}
     flags = {f: np.zeros(n, dtype=bool)
@@ -200,7 +142,7 @@ def _phone_rows() -> _PhoneRows:
         flags["velar"][i] = inf.name in _VELAR
         if phone == PAUSE:
             continue
-        tgt = _target_for(phone)
+        tgt = target_for(phone)
         v = tgt.values
         rows["start"][i], rows["end"][i] = tgt.start, tgt.end
         rows["av"][i] = v["AV"]
