@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import TableError
-from ..speech.phoneset import phones
+from ..speech.phoneset import phones, written_forms
 from ..speech.timeline import Timeline
 from ..tables import finite_float, iter_tsv, package_file
 
@@ -124,7 +124,7 @@ def viseme_nodes() -> dict[str, np.ndarray]:
 @cache
 def _viseme_by_phone() -> dict[str, str]:
     """phone_map() keyed by every phone string as written, stress digit included."""
-    return {ph + d: vis for ph, vis in phone_map().items() for d in ("", "0", "1", "2")}
+    return {s: vis for ph, vis in phone_map().items() for s in written_forms(ph)}
 
 
 def viseme_of(phone: str) -> str:

@@ -31,7 +31,7 @@ from pathlib import Path
 
 from ..errors import TableError
 from ..tables import iter_tsv, package_file
-from .phoneset import PAUSE, phones
+from .phoneset import PAUSE, phones, written_forms
 from .phrasing import Phrase
 
 MIN_SEGMENT_S = 0.015  # floor so every phone spans at least three 5 ms frames
@@ -125,7 +125,7 @@ def _segment(phone: str, table: dict[str, SegmentDuration]) -> _Segment:
 def _segments() -> dict[str, _Segment]:
     """_segment for every phone string in the table, with and without stress digits."""
     table = duration_table()
-    return {ph + d: _segment(ph + d, table) for ph in table for d in ("", "0", "1", "2")}
+    return {s: _segment(s, table) for ph in table for s in written_forms(ph)}
 
 
 def phrase_durations_s(phrase: Phrase, scale: float) -> list[list[float]]:

@@ -15,7 +15,7 @@ from pathlib import Path
 from ..errors import TableError
 from ..tables import iter_tsv, package_file
 from .lts import lts_predict
-from .phoneset import is_valid
+from .phoneset import is_valid, written_forms
 from .phoneset import phones as phone_table
 from .tokens import BreakToken, Pronounced, PronouncedWord, Token, WordToken
 
@@ -40,8 +40,7 @@ def _cmudict_path() -> Path:
 @cache
 def _valid_phone_strings() -> frozenset[str]:
     """Every string :func:`is_valid` accepts (each phone bare or with a stress digit)."""
-    return frozenset(c for name in phone_table() for c in (name, name + "0", name + "1", name + "2")
-                     if is_valid(c))
+    return frozenset(s for name in phone_table() for s in written_forms(name) if is_valid(s))
 
 
 def _parse_entries(path: Path, *, first_only: bool = True) -> dict[str, str]:

@@ -18,6 +18,8 @@ CLASSES = frozenset(
      "aspirate", "silence"}
 )
 PAUSE = "pau"
+# A phone string is a phone name plus at most one stress digit (vowels need one).
+STRESS_MARKS = ("", "0", "1", "2")
 
 
 @dataclass(frozen=True, slots=True)
@@ -77,7 +79,13 @@ def info(phone: str) -> PhoneInfo:
 @cache
 def _info_by_string() -> dict[str, PhoneInfo]:
     """phones() keyed by every phone string as written (tracks.py asks per phone)."""
-    return {name + d: p for name, p in phones().items() for d in ("", "0", "1", "2")}
+    return {s: p for name, p in phones().items() for s in written_forms(name)}
+
+
+def written_forms(name: str) -> tuple[str, ...]:
+    """Every way phone ``name`` can be written in a phone string: bare or with a stress
+    digit. Tables keyed by phone string (as written in timelines) are built from this."""
+    return tuple(name + mark for mark in STRESS_MARKS)
 
 
 def is_valid(phone: str) -> bool:

@@ -30,7 +30,7 @@ from functools import cache
 import numpy as np
 
 from . import klatt_params as kp
-from .phoneset import PAUSE, info, phones
+from .phoneset import PAUSE, info, phones, written_forms
 from .targets import FORMANT_FIELDS_N, target_for
 from .timeline import Timeline
 from .voices import Voice
@@ -120,8 +120,7 @@ class _PhoneRows:
 
 @cache
 def _phone_rows() -> _PhoneRows:
-    names = [PAUSE] + [name + d for name, p in phones().items() if name != PAUSE
-                       for d in ("", "0", "1", "2")]
+    names = [PAUSE] + [s for name in phones() if name != PAUSE for s in written_forms(name)]
     n = len(names)
     rows = {"cls": np.zeros(n, dtype=np.int64), "start": np.zeros((n, FORMANT_FIELDS_N)),
             "end": np.zeros((n, FORMANT_FIELDS_N)), "av": np.zeros(n),
