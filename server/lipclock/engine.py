@@ -12,7 +12,7 @@ chunk. Everything here is pure: no clocks, sockets or asyncio.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -230,12 +230,13 @@ def chunk_bounds(timeline: Timeline, first_chunk_s: float = FIRST_CHUNK_S,
     return bounds
 
 
-def render_chunks(work: Work) -> Iterator[tuple[int, np.ndarray]]:
-    """Yield ``(start_sample, int16 samples)`` covering the utterance exactly once, in order."""
+def _render(work: Work, bounds: Iterable[int]) -> Iterator[tuple[int, np.ndarray]]:
+    """Yield ``(start_sample, int16 samples)`` for consecutive pieces ending at ``bounds``.
+    Any choice of bounds gives the same samples (the Klatt renderer is chunk-exact)."""
     assert work.timeline is not None
     if work.samples is not None:  # system voice: the audio exists already
         start = 0
-        for end in chunk_bounds(work.timeline):
+        for end in bounds:
             yield start, work.samples[start:end]
             start = end
         return
@@ -243,33 +244,32 @@ def render_chunks(work: Work) -> Iterator[tuple[int, np.ndarray]]:
     r = work.request
     renderer = klatt.KlattRenderer(work.frames, r.prosody.sample_rate, r.voice, seed=0)
     start = 0
-    for end in chunk_bounds(work.timeline):
-        samples = renderer.render_until(end)
-        yield start, samples
+    for end in bounds:
+        yield start, renderer.render_until(end)
         start = end
+
+
+def render_chunks(work: Work) -> Iterator[tuple[int, np.ndarray]]:
+    """Yield ``(start_sample, int16 samples)`` covering the utterance exactly once, in order."""
+    assert work.timeline is not None
+    return _render(work, chunk_bounds(work.timeline))
 
 
 RENDER_PIECE_S = 1.0  # render_all's piece size: fewer kernel calls than streaming chunks
 
 
 def render_all(work: Work) -> np.ndarray:
-    """All the int16 samples at once: exactly :func:`render_chunks`' chunks concatenated
-    (any chunking renders the same samples), made in 1 s pieces into one array."""
+    """All the int16 samples at once: exactly :func:`render_chunks`' chunks concatenated,
+    made in 1 s pieces into one array."""
     assert work.timeline is not None
-    if work.samples is not None:  # system voice: the audio exists already
-        parts = [samples for _, samples in render_chunks(work)]
-        return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int16)
-    assert work.frames is not None
-    r = work.request
-    sr = r.prosody.sample_rate
-    renderer = klatt.KlattRenderer(work.frames, sr, r.voice, seed=0)
     total = work.timeline.num_samples
+    step = max(1, round(RENDER_PIECE_S * work.request.prosody.sample_rate))
     out = np.empty(total, dtype=np.int16)
-    step = max(1, round(RENDER_PIECE_S * sr))
-    for start in range(0, total, step):
-        end = min(total, start + step)
-        out[start:end] = renderer.render_until(end)
-    return out
+    end = 0
+    for start, samples in _render(work, [*range(step, total, step), total]):
+        end = start + len(samples)
+        out[start:end] = samples
+    return out[:end]  # a system voice's audio may end before the timeline does
 
 
 def prepare_work(text: str, **options: Any) -> Work:
