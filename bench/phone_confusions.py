@@ -31,15 +31,14 @@ sys.path.insert(0, str(HERE))
 
 import bench_intelligibility as bi  # noqa: E402
 
-_SYSTEMS: dict = {}
 _DEC: list = []
 
 
 def _init() -> None:
+    """bench_intelligibility's worker set-up (its systems) plus an allphone decoder."""
     import pocketsphinx
 
     bi._worker_init()
-    _SYSTEMS.update(bi.available_systems())
     model = Path(pocketsphinx.get_model_path()) / "en-us" / "en-us-phone.lm.bin"
     _DEC.append(pocketsphinx.Decoder(samprate=bi.LISTEN_RATE, allphone=str(model),
                                      lw=2.0, beam=1e-20, pbeam=1e-20, loglevel="FATAL"))
@@ -48,14 +47,14 @@ def _init() -> None:
 def reference_phones(text: str) -> list[str]:
     import lipclock
 
-    utt = lipclock.synthesize(text, voice="adult-low")
-    return [re.sub(r"\d", "", p.phone) for p in utt.phones if p.phone not in ("pau", "sil")]
+    prepared = lipclock.prepare(text, voice="adult-low")  # phones only: no audio needed
+    return [re.sub(r"\d", "", p.phone) for p in prepared.phones if p.phone not in ("pau", "sil")]
 
 
 def _job(job: tuple[str, str]) -> tuple[str, str, list[str]]:
     system, text = job
     with tempfile.TemporaryDirectory(prefix="phones-") as tmp:
-        samples = _SYSTEMS[system](text, Path(tmp))
+        samples = bi._SYSTEMS[system](text, Path(tmp))
     d = _DEC[0]
     d.start_utt()
     d.process_raw(bi.listener_input(samples, text).tobytes(), full_utt=True)
